@@ -1,0 +1,45 @@
+"""The ``sarcli`` entry point: discovers command modules in :mod:`sarcli.cli.commands`.
+
+Each module there defines ``register(app)`` and adds its commands or sub-apps. Adding a command
+group touches nothing else.
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+
+from sarcli import __version__
+from sarcli.cli import commands
+from sarcli.cli.common import make_typer
+
+app = make_typer(
+    help=(
+        "sarcli: SAR processing from raw echoes and GB-SAR scans to products.\n\n"
+        "Examples:\n\n"
+        "  sarcli simulate samples/rs1_point.toml -o raw.h5\n\n"
+        "  sarcli info raw.h5 --json\n\n"
+        "Run 'sarcli COMMAND --help' for a command's options and examples."
+    ),
+)
+
+
+@app.callback()
+def _root(version: bool = False) -> None:
+    """sarcli command line."""
+    if version:
+        print(__version__)
+
+
+def _register_all() -> None:
+    for mod in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{commands.__name__}.{mod.name}")
+        module.register(app)
+
+
+_register_all()
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()

@@ -1,0 +1,93 @@
+"""Helpers shared by all commands: one-line errors, JSON output, progress bars, typer factory."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any, TypeVar
+
+import click
+import typer
+from typer.core import TyperGroup
+
+from sarcli.errors import SarcliError
+from sarcli.io.h5common import to_jsonable
+
+T = TypeVar("T")
+
+
+class _OneLineError(click.ClickException):
+    def __init__(self, message: str, exit_code: int):
+        super().__init__(message)
+        self.exit_code = exit_code
+
+    def show(self, file: Any = None) -> None:
+        click.echo(f"sarcli: error: {self.format_message()}", err=True)
+
+
+class SarcliGroup(TyperGroup):
+    """A command group that turns user errors into one line on stderr and a non-zero exit."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except SarcliError as e:
+            raise _OneLineError(str(e), e.exit_code) from None
+        except (FileNotFoundError, PermissionError, IsADirectoryError) as e:
+            name = getattr(e, "filename", None)
+            raise _OneLineError(f"{name}: {e.strerror}" if name else str(e), 2) from None
+        except KeyboardInterrupt:
+            raise _OneLineError("interrupted", 130) from None
+
+
+def make_typer(**kwargs: Any) -> typer.Typer:
+    """A Typer app/sub-app with sarcli's error handling and conventions."""
+    kwargs.setdefault("no_args_is_help", True)
+    kwargs.setdefault("add_completion", False)
+    kwargs.setdefault("pretty_exceptions_enable", False)
+    kwargs.setdefault("rich_markup_mode", None)
+    return typer.Typer(cls=SarcliGroup, **kwargs)
+
+
+def emit_json(obj: Any) -> None:
+    """Print one JSON document on stdout (numpy types converted, NaN -> null)."""
+    sys.stdout.write(json.dumps(to_jsonable(obj), indent=2, sort_keys=False) + "\n")
+    sys.stdout.flush()
+
+
+def info(msg: str, quiet: bool = False) -> None:
+    """Human-readable progress/info line on stderr (stdout stays clean for --json)."""
+    if not quiet:
+        typer.echo(msg, err=True)
+
+
+def _progress_enabled(disable: bool) -> bool:
+    if disable or os.environ.get("SARCLI_NO_PROGRESS"):
+        return False
+    return sys.stderr.isatty()
+
+
+def progress(items: Iterable[T], total: int | None = None, label: str = "", disable: bool = False) -> Iterator[T]:
+    """Iterate with a progress bar (ETA) on stderr when it is a terminal; silent otherwise."""
+    if not _progress_enabled(disable):
+        yield from items
+        return
+    with click.progressbar(items, length=total, label=label, file=sys.stderr, show_eta=True,
+                           show_percent=True) as bar:
+        yield from bar
+
+
+@contextmanager
+def progress_bar(total: int, label: str = "", disable: bool = False) -> Iterator[Any]:
+    """A manual progress bar: ``with progress_bar(n) as bar: bar.update(1)``; no-op when not a tty."""
+    if not _progress_enabled(disable):
+        class _Null:
+            def update(self, n: int = 1) -> None:
+                pass
+        yield _Null()
+        return
+    with click.progressbar(length=total, label=label, file=sys.stderr, show_eta=True) as bar:
+        yield bar

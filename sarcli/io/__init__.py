@@ -1,0 +1,1 @@
+"""File formats: HDF5 products, GeoTIFF/PNG images, CEOS RAW and MATLAB blocks."""

@@ -1,0 +1,259 @@
+"""The GB-SAR scan product (``product_type = "gbsar_scan"``), schema version 1.
+
+One schema for simulated scans (``sarcli gbsar simulate``) and measured ones (``sarcli gbsar scan``).
+Measured scans are written stop by stop: the stop axis is resizable and every completed stop is
+flushed before the rail moves on, so an interrupted acquisition keeps every line it measured and
+the file stays valid (``n_complete`` counts the valid stops).
+
+Layout (SI units)::
+
+    /                  provenance attributes, epoch_utc, polarizations (comma list, e.g. "VV,HH"),
+                       n_planned (planned stops), n_complete (stops written), status
+                       ("complete" | "interrupted" | "simulated"), source ("simulated" | "measured")
+    /s21               complex64 (n_pol, n_stops, n_freq): S21 per polarization, rail stop, frequency
+    /frequency         float64 (n_freq,) Hz, increasing
+    /rail_position     float64 (n_stops,) m along the rail (x), increasing
+    /rail_height       float64 (n_stops,) m, antenna phase-centre height above the reference (z)
+    /stop_time         float64 (n_stops,) s after epoch_utc (start of the stop's sweeps)
+    /stop_flags        uint8 (n_stops,) 0 = good, 1 = NaN/invalid sweep (skipped by focusing)
+    /antenna           attributes: length_azimuth_m (L_x), length_range_m (L_R), beamwidth_rad,
+                       gain_dbi
+    /site              attributes: latitude_deg, longitude_deg, height_m (rail centre, WGS-84),
+                       heading_deg (direction of increasing rail position, clockwise from north),
+                       look_side ("right" | "left" of the rail direction)
+    /instrument        attributes: settings as applied (if_bandwidth_hz, power_dbm, points, vna_idn,
+                       rail_idn, settle_s, ...), free-form but JSON-serializable scalars
+    /truth             optional, simulated scans: scene_toml attribute and target tables
+
+Phase convention: a scatterer at one-way range R from the antenna phase centre gives
+S21 ∝ exp(-j*4*pi*f*R/c).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import h5py
+import numpy as np
+
+from sarcli.errors import ProductError
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+
+PRODUCT_TYPE = "gbsar_scan"
+SCHEMA_VERSION = "1"
+POLARIZATIONS = ("VV", "VH", "HV", "HH")
+
+
+@dataclass
+class Site:
+    """Rail geodetic position (centre) and heading; heading in degrees clockwise from north."""
+
+    latitude_deg: float = 0.0
+    longitude_deg: float = 0.0
+    height_m: float = 0.0
+    heading_deg: float = 0.0
+    look_side: str = "right"
+
+
+@dataclass
+class Antenna:
+    length_azimuth_m: float = 0.25
+    length_range_m: float = 0.25
+    beamwidth_rad: float = float(np.deg2rad(15.0))
+    gain_dbi: float = 20.0
+
+
+@dataclass
+class Scan:
+    """In-memory GB-SAR scan. ``s21`` is (n_pol, n_stops, n_freq) complex64."""
+
+    s21: np.ndarray
+    frequency: np.ndarray
+    rail_position: np.ndarray
+    rail_height: np.ndarray
+    polarizations: tuple[str, ...]
+    epoch_utc: str
+    stop_time: np.ndarray | None = None
+    stop_flags: np.ndarray | None = None
+    site: Site = field(default_factory=Site)
+    antenna: Antenna = field(default_factory=Antenna)
+    instrument: dict[str, Any] = field(default_factory=dict)
+    truth: dict[str, Any] | None = None
+    source: str = "simulated"
+    status: str = "simulated"
+    n_planned: int | None = None
+
+    @property
+    def n_stops(self) -> int:
+        return int(self.s21.shape[1])
+
+    def pol(self, name: str) -> np.ndarray:
+        """(n_stops, n_freq) S21 of one polarization."""
+        if name not in self.polarizations:
+            raise ProductError(f"scan has polarizations {','.join(self.polarizations)}, not {name}")
+        return self.s21[self.polarizations.index(name)]
+
+
+def _validate(s: Scan, where: str) -> None:
+    if s.s21.ndim != 3:
+        raise ProductError(f"{where}: s21 must be (n_pol, n_stops, n_freq), got shape {s.s21.shape}")
+    n_pol, n_stops, n_freq = s.s21.shape
+    if n_pol != len(s.polarizations) or any(p not in POLARIZATIONS for p in s.polarizations):
+        raise ProductError(f"{where}: polarizations {s.polarizations} do not match s21's {n_pol} planes")
+    if s.frequency.shape != (n_freq,):
+        raise ProductError(f"{where}: frequency has shape {s.frequency.shape}, expected ({n_freq},)")
+    if n_freq > 1 and not np.all(np.diff(s.frequency) > 0):
+        raise ProductError(f"{where}: frequencies must be strictly increasing")
+    for name in ("rail_position", "rail_height"):
+        if getattr(s, name).shape != (n_stops,):
+            raise ProductError(f"{where}: {name} must have {n_stops} values")
+
+
+def _write_static(f: h5py.File, s: Scan) -> None:
+    f.attrs["epoch_utc"] = s.epoch_utc
+    f.attrs["polarizations"] = ",".join(s.polarizations)
+    f.attrs["source"] = s.source
+    dataset(f, "frequency", np.asarray(s.frequency, np.float64), units="Hz")
+    for name, obj in (("site", s.site), ("antenna", s.antenna)):
+        g = group(f, name)
+        for k, v in vars(obj).items():
+            g.attrs[k] = v
+    g = group(f, "instrument")
+    for k, v in sorted(s.instrument.items()):
+        g.attrs[k] = v
+    if s.truth is not None:
+        tg = group(f, "truth")
+        for k in sorted(s.truth):
+            v = s.truth[k]
+            if isinstance(v, str):
+                tg.attrs[k] = v
+            else:
+                dataset(tg, k, np.asarray(v))
+
+
+def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None, inputs: tuple = ()) -> None:
+    """Validate and write a complete scan atomically."""
+    _validate(s, str(path))
+    n_stops = s.n_stops
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
+        _write_static(f, s)
+        f.attrs["n_planned"] = s.n_planned if s.n_planned is not None else n_stops
+        f.attrs["n_complete"] = n_stops
+        f.attrs["status"] = s.status
+        dataset(f, "s21", np.asarray(s.s21, np.complex64), units="1")
+        dataset(f, "rail_position", np.asarray(s.rail_position, np.float64), units="m")
+        dataset(f, "rail_height", np.asarray(s.rail_height, np.float64), units="m")
+        st = s.stop_time if s.stop_time is not None else np.zeros(n_stops)
+        dataset(f, "stop_time", np.asarray(st, np.float64), units="s")
+        fl = s.stop_flags if s.stop_flags is not None else np.zeros(n_stops, np.uint8)
+        dataset(f, "stop_flags", np.asarray(fl, np.uint8), units="1")
+
+
+def read_scan(path: str | os.PathLike) -> Scan:
+    """Read a scan (only its ``n_complete`` valid stops); a malformed file raises ProductError."""
+    with open_product(path, PRODUCT_TYPE) as f:
+        if attr_str(f, "schema_version") != SCHEMA_VERSION:
+            raise ProductError(f"{path}: unsupported gbsar_scan schema version")
+        n = int(f.attrs.get("n_complete", 0))
+        s21 = require(f, "s21", path, shape_rank=3, dtype_kind="c")[:, :n, :]
+        pols = tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p)
+
+        def attrs(name: str) -> dict[str, Any]:
+            if name not in f:
+                return {}
+            return {k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
+                    for k, v in f[name].attrs.items()}
+
+        truth = None
+        if "truth" in f:
+            tg = f["truth"]
+            truth = {k: tg[k][()] for k in tg}
+            truth.update({k: attr_str(tg, k) for k in tg.attrs})
+        s = Scan(
+            s21=s21,
+            frequency=require(f, "frequency", path, shape_rank=1)[()],
+            rail_position=require(f, "rail_position", path, shape_rank=1)[:n],
+            rail_height=require(f, "rail_height", path, shape_rank=1)[:n],
+            polarizations=pols,
+            epoch_utc=attr_str(f, "epoch_utc") or "",
+            stop_time=require(f, "stop_time", path, shape_rank=1)[:n],
+            stop_flags=require(f, "stop_flags", path, shape_rank=1)[:n],
+            site=Site(**attrs("site")),
+            antenna=Antenna(**attrs("antenna")),
+            instrument=attrs("instrument"),
+            truth=truth,
+            source=attr_str(f, "source", "unknown"),
+            status=attr_str(f, "status", "unknown"),
+            n_planned=int(f.attrs.get("n_planned", n)),
+        )
+    _validate(s, str(path))
+    return s
+
+
+class ScanWriter:
+    """Append stops to a scan file as they are measured; each stop is flushed before returning.
+
+    The file is created (atomically: it appears complete with zero stops) by :meth:`create` or
+    reopened for ``--resume`` by :meth:`resume`. ``n_complete`` is updated after the stop's data
+    are written and flushed, so a crash between the two leaves the previous count valid.
+    """
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = str(path)
+        self.f = h5py.File(self.path, "r+")
+        self.n_complete = int(self.f.attrs["n_complete"])
+
+    @classmethod
+    def create(cls, path: str | os.PathLike, template: Scan, n_planned: int,
+               parameters: dict | None = None) -> ScanWriter:
+        """Create an empty, valid scan file for ``n_planned`` stops (template gives frequency, pols...)."""
+        n_pol, n_freq = len(template.polarizations), template.frequency.shape[0]
+        with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters) as f:
+            _write_static(f, template)
+            f.attrs["n_planned"] = n_planned
+            f.attrs["n_complete"] = 0
+            f.attrs["status"] = "interrupted"
+            dataset(f, "s21", np.zeros((n_pol, 0, n_freq), np.complex64), units="1",
+                    chunks=(n_pol, 1, n_freq), maxshape=(n_pol, None, n_freq))
+            for name, dt, unit in (("rail_position", np.float64, "m"), ("rail_height", np.float64, "m"),
+                                   ("stop_time", np.float64, "s"), ("stop_flags", np.uint8, "1")):
+                dataset(f, name, np.zeros(0, dt), units=unit, chunks=(256,), maxshape=(None,))
+        return cls(path)
+
+    @classmethod
+    def resume(cls, path: str | os.PathLike) -> ScanWriter:
+        """Reopen an interrupted scan for appending."""
+        with open_product(path, PRODUCT_TYPE):
+            pass
+        return cls(path)
+
+    def append(self, s21_stop: np.ndarray, position_m: float, height_m: float, time_s: float,
+               flag: int = 0) -> None:
+        """Write one stop (``s21_stop`` is (n_pol, n_freq)) and flush it to disk."""
+        f, k = self.f, self.n_complete
+        for name in ("s21", "rail_position", "rail_height", "stop_time", "stop_flags"):
+            ds = f[name]
+            if name == "s21":
+                ds.resize(k + 1, axis=1)
+                ds[:, k, :] = np.asarray(s21_stop, np.complex64)
+            else:
+                ds.resize((k + 1,))
+        f["rail_position"][k] = position_m
+        f["rail_height"][k] = height_m
+        f["stop_time"][k] = time_s
+        f["stop_flags"][k] = flag
+        f.flush()
+        f.attrs["n_complete"] = k + 1
+        f.flush()
+        self.n_complete = k + 1
+
+    def finish(self, status: str = "complete") -> None:
+        self.f.attrs["status"] = status
+        self.close()
+
+    def close(self) -> None:
+        if self.f.id.valid:
+            self.f.flush()
+            self.f.close()
