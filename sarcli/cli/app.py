@@ -9,6 +9,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
+import typer
+
 from sarcli import __version__
 from sarcli.cli import commands
 from sarcli.cli.common import make_typer
@@ -24,11 +26,18 @@ app = make_typer(
 )
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(__version__)
+        raise typer.Exit()
+
+
 @app.callback()
-def _root(version: bool = False) -> None:
+def _root(
+    version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+                                 help="Print the version and exit."),
+) -> None:
     """sarcli command line."""
-    if version:
-        print(__version__)
 
 
 def _register_all() -> None:
