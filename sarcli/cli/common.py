@@ -9,7 +9,6 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-import click
 import typer
 from typer.core import TyperGroup
 
@@ -19,28 +18,25 @@ from sarcli.io.h5common import to_jsonable
 T = TypeVar("T")
 
 
-class _OneLineError(click.ClickException):
-    def __init__(self, message: str, exit_code: int):
-        super().__init__(message)
-        self.exit_code = exit_code
-
-    def show(self, file: Any = None) -> None:
-        click.echo(f"sarcli: error: {self.format_message()}", err=True)
+def fail(message: str, exit_code: int = 2) -> typer.Exit:
+    """Print ``sarcli: error: message`` on stderr and return the Exit to raise."""
+    typer.echo(f"sarcli: error: {message}", err=True)
+    return typer.Exit(exit_code)
 
 
 class SarcliGroup(TyperGroup):
     """A command group that turns user errors into one line on stderr and a non-zero exit."""
 
-    def invoke(self, ctx: click.Context) -> Any:
+    def invoke(self, ctx: typer.Context) -> Any:
         try:
             return super().invoke(ctx)
         except SarcliError as e:
-            raise _OneLineError(str(e), e.exit_code) from None
+            raise fail(str(e), e.exit_code) from None
         except (FileNotFoundError, PermissionError, IsADirectoryError) as e:
             name = getattr(e, "filename", None)
-            raise _OneLineError(f"{name}: {e.strerror}" if name else str(e), 2) from None
+            raise fail(f"{name}: {e.strerror}" if name else str(e)) from None
         except KeyboardInterrupt:
-            raise _OneLineError("interrupted", 130) from None
+            raise fail("interrupted", 130) from None
 
 
 def make_typer(**kwargs: Any) -> typer.Typer:
@@ -75,7 +71,7 @@ def progress(items: Iterable[T], total: int | None = None, label: str = "", disa
     if not _progress_enabled(disable):
         yield from items
         return
-    with click.progressbar(items, length=total, label=label, file=sys.stderr, show_eta=True,
+    with typer.progressbar(items, length=total, label=label, file=sys.stderr, show_eta=True,
                            show_percent=True) as bar:
         yield from bar
 
@@ -89,5 +85,5 @@ def progress_bar(total: int, label: str = "", disable: bool = False) -> Iterator
                 pass
         yield _Null()
         return
-    with click.progressbar(length=total, label=label, file=sys.stderr, show_eta=True) as bar:
+    with typer.progressbar(length=total, label=label, file=sys.stderr, show_eta=True) as bar:
         yield bar
