@@ -1,0 +1,76 @@
+"""``sarcli design``: the SAR design calculator (seed 004 relations) with a verdict per constraint."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from sarcli.cli.common import emit_json
+from sarcli.errors import SarcliError
+
+
+def design(
+    source: Path = typer.Argument(..., help="Design TOML ([design] table), raw product (.h5) or GB-SAR scan (.h5)."),
+    json_out: bool = typer.Option(False, "--json", help="Print the full report as JSON."),
+) -> None:
+    """Derive resolutions, PRF window, Doppler samples and swath, and check each constraint.
+
+    Examples:
+
+      sarcli design samples/aod_ccd_example.toml
+
+      sarcli design samples/design_radarsat1.toml --json
+
+      sarcli design raw.h5
+
+    Exit status 0 also when a constraint is violated: violations are reported, not errors.
+    """
+    from sarcli.design.params import load
+    from sarcli.design.report import evaluate
+
+    params = load(source)
+    try:
+        report = evaluate(params)
+    except ValueError as e:
+        raise SarcliError(f"{source}: {e}") from None
+    if json_out:
+        emit_json(report)
+        return
+    typer.echo(_format(report))
+
+
+def _format(r: dict) -> str:
+    lines = [f"design of {r['source']} ({r['platform']})",
+             f"  wavelength                 {r['wavelength_m']:.5f} m",
+             f"  bandwidth                  {r['bandwidth_hz'] / 1e6:.3f} MHz",
+             f"  slant-range resolution     {r['slant_range_resolution_m']:.2f} m   c/(2B)",
+             f"  ground-range resolution    {r['ground_range_resolution_m']:.2f} m   c/(2B sin i)",
+             f"  azimuth resolution         {r['azimuth_resolution_m']:.2f} m"]
+    if r["platform"] == "gbsar":
+        lines += [f"  unambiguous range          {r['r_max_m']:.1f} m   c/(4 df)",
+                  f"  rail-limited beyond        {r['rail_limited_beyond_m']:.1f} m"]
+        for x in r["resolution_by_range"]:
+            lines.append(f"    R = {x['range_m']:8.1f} m: azimuth {x['azimuth_resolution_m']:.3f} m, "
+                         f"region {x['region']}")
+        for c in r["constraints"]:
+            lines.append(f"  [{'ok' if c['ok'] else 'VIOLATED'}] {c['name']}: {c['value']:.4g} vs {c['limit']:.4g} "
+                         f"({c['relation']})")
+    else:
+        lines += [f"  slant range (centre)       {r['slant_range_m']:.1f} m, "
+                  f"incidence {r['incidence_angle_deg']:.2f} deg",
+                  f"  swath (slant)              {r['swath_slant_m']:.1f} m",
+                  f"  PRF window                 {r['prf_min_hz']:.1f} Hz < PRF < {r['prf_max_hz']:.1f} Hz",
+                  "  PRF options:"]
+        for o in r["prf_options"]:
+            broken = ", ".join(c["name"] for c in o["constraints"] if not c["ok"])
+            lines.append(f"    {o['prf_hz']:9.1f} Hz: N = {o['doppler_samples']:5d} Doppler samples, "
+                         f"aperture {o['synthetic_aperture_m']:.2f} m, azimuth {o['azimuth_resolution_m']:.2f} m "
+                         f"-> {'VIOLATES ' + broken if broken else 'ok'}")
+    lines += [f"  note: {n}" for n in r["notes"]]
+    lines.append("  verdict: " + ("all constraints met" if r["ok"] else "; ".join(r["violations"])))
+    return "\n".join(lines)
+
+
+def register(app: typer.Typer) -> None:
+    app.command("design")(design)

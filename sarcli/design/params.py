@@ -1,0 +1,211 @@
+"""Design parameters: from a design TOML (``[design]`` table), a raw product or a GB-SAR scan.
+
+A design TOML (see ``samples/aod_ccd_example.toml``)::
+
+    [design]
+    platform = "airborne"            # airborne (flat Earth) | spaceborne (spherical Earth) | gbsar
+    carrier_frequency_hz = 10.0e9
+    chirp_rate_hz_per_s = 0.5e12     # or bandwidth_hz
+    pulse_length_s = 20e-6
+    altitude_m = 5000.0
+    velocity_mps = 250.0
+    look_angle_deg = 30.0
+    look_angle_from = "horizontal"   # "horizontal" (depression, the seed's convention) or "nadir"
+    squint_angle_deg = 90.0          # angle between velocity and line of sight (90 = broadside)
+    antenna_length_m = 2.0           # optional: real antenna (azimuth), enables PRF > 2v/D
+    swath_slant_m = 4000.0           # optional: else from the AOD aperture, else 0
+    prf_hz = [15734, 3934, 1967]
+    [design.processor]               # optional: the AOD/CCD optical processor of seed 004
+    ccd_rows = 491
+    ccd_line_rate_hz = 15734.0
+    aod_aperture_m = 0.031
+    aod_velocity_mps = 617.0
+
+GB-SAR designs use ``platform = "gbsar"`` with frequency_start_hz, frequency_stop_hz,
+n_frequencies, rail_length_m, rail_step_m, antenna_length_m, beamwidth_deg, antenna_height_m and
+ranges_m (the ranges at which to evaluate resolution).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from orbit.constants import C_LIGHT, WGS84_A
+from sarcli.errors import SarcliError
+
+PLATFORMS = ("airborne", "spaceborne", "gbsar")
+
+
+@dataclass
+class Processor:
+    ccd_rows: int | None = None
+    ccd_line_rate_hz: float | None = None
+    aod_aperture_m: float | None = None
+    aod_velocity_mps: float | None = None
+
+
+@dataclass
+class DesignParams:
+    platform: str
+    carrier_frequency_hz: float
+    chirp_rate_hz_per_s: float | None = None
+    pulse_length_s: float | None = None
+    bandwidth_hz: float | None = None
+    altitude_m: float | None = None
+    velocity_mps: float | None = None
+    look_angle_deg: float | None = None
+    look_angle_from: str = "horizontal"
+    squint_angle_deg: float = 90.0
+    antenna_length_m: float | None = None
+    swath_slant_m: float | None = None
+    slant_range_m: float | None = None
+    prf_hz: list[float] = field(default_factory=list)
+    processor: Processor = field(default_factory=Processor)
+    # GB-SAR
+    frequency_start_hz: float | None = None
+    frequency_stop_hz: float | None = None
+    n_frequencies: int | None = None
+    rail_length_m: float | None = None
+    rail_step_m: float | None = None
+    beamwidth_deg: float | None = None
+    antenna_height_m: float = 0.0
+    ranges_m: list[float] = field(default_factory=list)
+    source: str = ""
+
+    @property
+    def wavelength_m(self) -> float:
+        return C_LIGHT / self.carrier_frequency_hz
+
+
+def _need(p: DesignParams, names: tuple[str, ...], where: str) -> None:
+    missing = [n for n in names if getattr(p, n) in (None, [])]
+    if missing:
+        raise SarcliError(f"{where}: a {p.platform} design needs {', '.join(missing)}")
+
+
+def validate(p: DesignParams, where: str) -> DesignParams:
+    """Check completeness and ranges; one-line SarcliError on the first problem."""
+    if p.platform not in PLATFORMS:
+        raise SarcliError(f"{where}: platform must be one of {', '.join(PLATFORMS)}, got {p.platform!r}")
+    if not (p.carrier_frequency_hz and p.carrier_frequency_hz > 0):
+        raise SarcliError(f"{where}: carrier_frequency_hz must be positive")
+    if p.platform == "gbsar":
+        _need(p, ("frequency_start_hz", "frequency_stop_hz", "n_frequencies", "rail_length_m",
+                  "rail_step_m", "antenna_length_m", "beamwidth_deg"), where)
+        if p.frequency_stop_hz <= p.frequency_start_hz or p.n_frequencies < 2:
+            raise SarcliError(f"{where}: need frequency_stop_hz > frequency_start_hz and n_frequencies >= 2")
+        return p
+    if p.bandwidth_hz is None:
+        _need(p, ("chirp_rate_hz_per_s", "pulse_length_s"), where)
+    _need(p, ("pulse_length_s", "altitude_m", "velocity_mps", "look_angle_deg", "prf_hz"), where)
+    if p.look_angle_from not in ("horizontal", "nadir"):
+        raise SarcliError(f"{where}: look_angle_from must be 'horizontal' or 'nadir'")
+    if not 0 < p.look_angle_deg < 90:
+        raise SarcliError(f"{where}: look_angle_deg must lie strictly between 0 and 90")
+    if not 0 < p.squint_angle_deg <= 90:
+        raise SarcliError(f"{where}: squint_angle_deg must lie in (0, 90]")
+    if any(not (f > 0) for f in p.prf_hz):
+        raise SarcliError(f"{where}: every prf_hz must be positive")
+    for name in ("altitude_m", "velocity_mps", "pulse_length_s"):
+        if not getattr(p, name) > 0:
+            raise SarcliError(f"{where}: {name} must be positive")
+    return p
+
+
+def from_toml(path: str | Path) -> DesignParams:
+    """Read the ``[design]`` table of a TOML file."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise SarcliError(f"{path}: not valid TOML ({e})") from None
+    if "design" not in doc:
+        raise SarcliError(f"{path}: no [design] table (see samples/aod_ccd_example.toml)")
+    d = dict(doc["design"])
+    proc = Processor(**{k: v for k, v in d.pop("processor", {}).items() if k in {f.name for f in fields(Processor)}})
+    known = {f.name for f in fields(DesignParams)} - {"processor", "source"}
+    unknown = sorted(set(d) - known)
+    if unknown:
+        raise SarcliError(f"{path}: unknown design key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    try:
+        p = DesignParams(processor=proc, source=path.name, **d)
+    except TypeError as e:
+        raise SarcliError(f"{path}: {e}") from None
+    return validate(p, str(path))
+
+
+def from_raw(path: str | Path) -> DesignParams:
+    """Design parameters of a stripmap raw product (height and speed from its orbit when present)."""
+    from sarcli.io.raw import raw_shape, read_raw
+
+    raw = read_raw(path, load_echo=False)
+    r = raw.radar
+    n_samples = raw_shape(path)[1]
+    swath = n_samples * C_LIGHT / (2 * r.range_sampling_rate_hz)
+    centre_range = r.first_range_m + swath / 2
+    if raw.orbit is not None and raw.orbit.frame in ("ECI", "ECEF"):
+        pos, vel = raw.orbit.position, raw.orbit.velocity
+        k = len(pos) // 2
+        rad = float(np.linalg.norm(pos[k]))
+        height = rad - WGS84_A
+        speed = float(np.linalg.norm(vel[k]))
+        platform = "spaceborne"
+        # look angle from nadir for the swath centre on a sphere of radius WGS84_A (law of cosines)
+        cosg = (rad**2 + centre_range**2 - WGS84_A**2) / (2 * rad * centre_range)
+        look = math.degrees(math.acos(max(-1.0, min(1.0, cosg))))
+        look_from = "nadir"
+    elif raw.orbit is not None:  # LOCAL airborne frame: z is height
+        height = float(raw.orbit.position[len(raw.orbit.position) // 2, 2])
+        speed = float(np.linalg.norm(raw.orbit.velocity[len(raw.orbit.velocity) // 2]))
+        platform = "airborne"
+        look = math.degrees(math.asin(min(1.0, height / centre_range)))
+        look_from = "horizontal"
+    else:
+        raise SarcliError(f"{path}: the product has no orbit; a design needs platform height and speed")
+    p = DesignParams(platform=platform, carrier_frequency_hz=r.carrier_frequency_hz,
+                     chirp_rate_hz_per_s=r.chirp_rate_hz_per_s, pulse_length_s=r.pulse_length_s,
+                     altitude_m=height, velocity_mps=speed, look_angle_deg=look, look_angle_from=look_from,
+                     swath_slant_m=swath, slant_range_m=centre_range, prf_hz=[r.prf_hz],
+                     source=Path(path).name)
+    return validate(p, str(path))
+
+
+def from_scan(path: str | Path) -> DesignParams:
+    """Design parameters of a GB-SAR scan product."""
+    from sarcli.io.scan import read_scan
+
+    s = read_scan(path)
+    f = s.frequency
+    x = s.rail_position
+    if f.size < 2 or x.size < 2:
+        raise SarcliError(f"{path}: a design needs at least 2 frequencies and 2 rail stops")
+    p = DesignParams(platform="gbsar", carrier_frequency_hz=float(f.mean()),
+                     frequency_start_hz=float(f[0]), frequency_stop_hz=float(f[-1]), n_frequencies=int(f.size),
+                     rail_length_m=float(x[-1] - x[0]), rail_step_m=float(np.median(np.diff(x))),
+                     antenna_length_m=s.antenna.length_azimuth_m,
+                     beamwidth_deg=math.degrees(s.antenna.beamwidth_rad),
+                     antenna_height_m=float(np.mean(s.rail_height)), source=Path(path).name)
+    return validate(p, str(path))
+
+
+def load(path: str | Path) -> DesignParams:
+    """Design parameters from a design TOML, a raw product or a GB-SAR scan."""
+    path = Path(path)
+    if not path.exists():
+        raise SarcliError(f"{path}: no such file")
+    if path.suffix.lower() == ".toml":
+        return from_toml(path)
+    from sarcli.io.h5common import attr_str, open_product
+
+    with open_product(path) as f:
+        ptype = attr_str(f, "product_type")
+    if ptype == "raw":
+        return from_raw(path)
+    if ptype == "gbsar_scan":
+        return from_scan(path)
+    raise SarcliError(f"{path}: a '{ptype}' product carries no design; give a raw, gbsar_scan or design TOML")
