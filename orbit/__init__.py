@@ -1,6 +1,34 @@
-"""orbit: pure geometry for spaceborne SAR (no file formats, no CLI, no sarcli imports).
+"""orbit: pure geometry for spaceborne SAR (numpy, numba, pyproj; no file formats, no CLI, no sarcli imports).
 
-Modules: ``constants`` (WGS-84, Earth rotation), ``timeutil`` (epochs, Julian dates),
-``frames`` (ECI <-> ECEF by Greenwich sidereal angle), ``geodetic`` (ECEF <-> lat/lon/h via pyproj),
-``propagate`` (Keplerian elements and J2 numerical propagation).
+Conventions: SI units, radians, float64; times are seconds after an ISO-8601 UTC epoch; positions m,
+velocities m/s. Frames: "ECI" = the GMST inertial frame of date (true equator, mean equinox; what the
+Radarsat-1 CEOS "inertial" vectors plus a Greenwich mean hour angle imply), "ECEF" = WGS-84
+Earth-fixed, "LOCAL" = flat-Earth Cartesian (airborne scenes). Errors are ``orbit.errors.OrbitError``
+(a ``ValueError``) with one-line messages.
+
+Public API (stable; other modules depend on it):
+
+``orbit.statevectors``
+    ``StateVectors(time, position, velocity, frame="ECI", epoch_utc="")`` - validated (sorted, no
+    duplicates, finite; non-uniform spacing is fine).
+    ``.interpolate(t, n_nodes=None, max_extrapolation_s=0.0) -> (pos, vel, acc)`` - Hermite using
+    positions and velocities over ``n_nodes`` (2..16, default ``DEFAULT_N_NODES`` = 10) nodes;
+    numba for vectors of t; output shape ``t.shape + (3,)``; outside the span raises
+    ``InterpolationRangeError`` unless within ``max_extrapolation_s``.
+    ``.to_ecef()`` / ``.to_eci()``, ``.span``, ``.spacing``, ``StateVectors.from_record(obj, epoch)``.
+    ``hermite_reference(...)`` - plain-numpy reference of the kernel.
+``orbit.frames``
+    ``gmst(epoch, t)``, ``eci_to_ecef(epoch, t, r, v=None)``, ``ecef_to_eci(...)``.
+``orbit.geodetic``
+    ``ecef_to_geodetic(r) -> (lat_deg, lon_deg, h)``, ``geodetic_to_ecef(lat_deg, lon_deg, h)`` (pyproj).
+``orbit.pointing``
+    flight frame (geodetic nadir), control rotation (exact / small-angle), look and beam vectors.
+``orbit.geometry``
+    ellipsoid target solve, look <-> incidence <-> slant range, zero-/given-Doppler time, geolocation.
+``orbit.propagate``
+    ``Keplerian``, ``kepler_to_state``, ``propagate_j2`` (truth orbits for simulation and tests).
+``orbit.constants``, ``orbit.timeutil``, ``orbit.errors``.
+
+Doppler sign: with the phase convention exp(-j*4*pi*R/lam), f_D = -(2/lam) dR/dt
+= +(2/lam) v_rel . (p - r)/|p - r| (positive when looking forward); see ``orbit.geometry``.
 """

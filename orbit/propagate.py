@@ -84,14 +84,13 @@ def propagate_j2(r0: np.ndarray, v0: np.ndarray, times: np.ndarray, rtol: float 
         tt = times[sel]
         if tt.size == 0:
             continue
-        order = np.argsort(np.abs(tt))
-        ts = tt[order]
-        t_end = ts[-1] if ts[-1] != 0 else sign
-        sol = solve_ivp(_rhs, (0.0, t_end), y0, method="DOP853", t_eval=ts, rtol=rtol, atol=atol,
-                        args=(GM_EARTH, j2, WGS84_A))
+        # t_eval must be strictly monotonic in the direction of integration: unique |t|, mapped back.
+        ts, inverse = np.unique(np.abs(tt), return_inverse=True)
+        t_end = sign * ts[-1] if ts[-1] != 0 else sign
+        sol = solve_ivp(_rhs, (0.0, t_end), y0, method="DOP853", t_eval=sign * ts, rtol=rtol,
+                        atol=atol, args=(GM_EARTH, j2, WGS84_A))
         if not sol.success:
             raise RuntimeError(f"orbit propagation failed: {sol.message}")
-        idx = np.flatnonzero(sel)[order]
-        out_r[idx] = sol.y[:3].T
-        out_v[idx] = sol.y[3:].T
+        out_r[sel] = sol.y[:3, inverse].T
+        out_v[sel] = sol.y[3:, inverse].T
     return out_r, out_v
