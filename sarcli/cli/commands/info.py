@@ -1,0 +1,164 @@
+"""``sarcli info``: summarize any sarcli product (raw in detail, every other type generically)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from sarcli.cli.common import emit_json
+from sarcli.cli.common import info as say
+
+
+def _attrs(obj) -> dict[str, Any]:
+    out = {}
+    for k in sorted(obj.attrs):
+        v = obj.attrs[k]
+        if isinstance(v, bytes):
+            v = v.decode(errors="replace")
+        elif hasattr(v, "dtype") and v.dtype.kind == "S":
+            v = v.astype(str)
+        out[k] = v
+    return out
+
+
+def _datasets(f) -> list[dict[str, Any]]:
+    import h5py
+
+    found: list[dict[str, Any]] = []
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            found.append({"path": "/" + name, "shape": list(obj.shape), "dtype": str(obj.dtype),
+                          "units": obj.attrs.get("units", None)})
+    f.visititems(visit)
+    return found
+
+
+def _utc(epoch: str | None, seconds: float) -> str | None:
+    from orbit.timeutil import add_seconds
+
+    if not epoch:
+        return None
+    try:
+        return add_seconds(epoch, seconds)
+    except ValueError:
+        return None
+
+
+def _time_span(f, name: str, epoch: str | None) -> dict[str, Any]:
+    t = f[name][()]
+    if t.size == 0:
+        return {}
+    return {"start_utc": _utc(epoch, float(t.min())), "stop_utc": _utc(epoch, float(t.max())),
+            "span_s": float(t.max() - t.min())}
+
+
+def _raw_summary(f, summary: dict[str, Any]) -> None:
+    from orbit.constants import C_LIGHT
+
+    radar = _attrs(f["radar"]) if "radar" in f else {}
+    epoch = summary.get("epoch_utc")
+    n_lines, n_samples = f["echo"].shape
+    span = _time_span(f, "azimuth_time", epoch) if "azimuth_time" in f else {}
+    fs = radar.get("range_sampling_rate_hz")
+    r0 = radar.get("first_range_m")
+    summary.update({
+        "shape": [n_lines, n_samples], "n_lines": n_lines, "n_samples": n_samples,
+        "prf_hz": radar.get("prf_hz"), "range_sampling_rate_hz": fs,
+        "wavelength_m": radar.get("wavelength_m"), "carrier_frequency_hz": radar.get("carrier_frequency_hz"),
+        "chirp_rate_hz_per_s": radar.get("chirp_rate_hz_per_s"), "pulse_length_s": radar.get("pulse_length_s"),
+        "first_range_m": r0,
+        "last_range_m": (r0 + (n_samples - 1) * C_LIGHT / (2 * fs)) if (r0 and fs) else None,
+        "quantization_bits": radar.get("quantization_bits"),
+        "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
+        "azimuth_span_s": span.get("span_s"),
+        "n_channels": summary.get("attributes", {}).get("n_channels", 1),
+        "has_replica": "replica" in f.get("radar", {}), "has_agc": "agc_db" in f.get("radar", {}),
+        "has_attitude": "attitude" in f, "has_truth": "truth" in f,
+        "radar": radar,
+    })
+    if "orbit" in f:
+        o = f["orbit"]
+        frame = o.attrs.get("frame", None)
+        ospan = _time_span(o, "time", epoch)
+        summary.update({"n_state_vectors": int(o["time"].shape[0]),
+                        "orbit_frame": frame.decode() if isinstance(frame, bytes) else frame,
+                        "orbit_start_utc": ospan.get("start_utc"), "orbit_stop_utc": ospan.get("stop_utc"),
+                        "orbit_span_s": ospan.get("span_s")})
+    else:
+        summary.update({"n_state_vectors": 0, "orbit_frame": None, "orbit_start_utc": None,
+                        "orbit_stop_utc": None, "orbit_span_s": None})
+
+
+def summarize(path: Path) -> dict[str, Any]:
+    """A JSON-ready summary of any sarcli product (keys documented in docs/readme/20-ingest-info.md)."""
+    from sarcli.io.h5common import PROVENANCE_ATTRS, open_product, provenance
+
+    with open_product(path) as f:
+        prov = provenance(f)
+        attrs = {k: v for k, v in _attrs(f).items() if k not in PROVENANCE_ATTRS}
+        datasets = _datasets(f)
+        main = max(datasets, key=lambda d: (len(d["shape"]) > 0, math.prod(d["shape"])),
+                   default=None)
+        summary: dict[str, Any] = {
+            "file": str(path), "product_type": prov["product_type"], "schema_version": prov["schema_version"],
+            "shape": main["shape"] if main else [], "main_dataset": main["path"] if main else None,
+            "epoch_utc": attrs.get("epoch_utc"), "source": attrs.get("source"),
+            "provenance": prov, "attributes": attrs, "datasets": datasets,
+        }
+        if prov["product_type"] == "raw" and "echo" in f:
+            summary["main_dataset"] = "/echo"
+            _raw_summary(f, summary)
+    return summary
+
+
+def _human(s: dict[str, Any]) -> None:
+    say(f"{s['file']}: {s['product_type']} product (schema {s['schema_version']}), "
+        f"shape {' x '.join(str(n) for n in s['shape'])} ({s['main_dataset']}), source {s.get('source')}")
+    p = s["provenance"]
+    say(f"  created {p.get('created_utc')} by sarcli {p.get('software_version')}: {p.get('command_line')}")
+    for inp in p.get("inputs") or []:
+        say(f"  input {inp.get('path')} sha256 {str(inp.get('sha256'))[:16]}...")
+    if s["product_type"] == "raw":
+        say(f"  azimuth {s['azimuth_start_utc']} .. {s['azimuth_stop_utc']} ({s['azimuth_span_s']:.3f} s), "
+            f"PRF {s['prf_hz']:.3f} Hz")
+        say(f"  range {s['first_range_m']:.2f} .. {s['last_range_m']:.2f} m, fs {s['range_sampling_rate_hz'] / 1e6:.6f}"
+            f" MHz, wavelength {s['wavelength_m']:.6f} m, chirp {s['chirp_rate_hz_per_s']:.6g} Hz/s, "
+            f"pulse {s['pulse_length_s'] * 1e6:.3f} us, {s['quantization_bits']} bit")
+        if s["n_state_vectors"]:
+            say(f"  orbit: {s['n_state_vectors']} state vectors ({s['orbit_frame']}), "
+                f"{s['orbit_start_utc']} .. {s['orbit_stop_utc']}")
+        else:
+            say("  orbit: none")
+    else:
+        for d in s["datasets"]:
+            say(f"  {d['path']}: {d['dtype']} {d['shape']}" + (f" [{d['units']}]" if d["units"] else ""))
+
+
+def info(
+    path: Path = typer.Argument(..., help="Any sarcli product (HDF5)."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object on stdout."),
+) -> None:
+    """Summarize a product: type, shape, time span, radar parameters, orbit, provenance.
+
+    Raw products get their radar and orbit summary; any other product type a generic summary of its
+    provenance, attributes and datasets.
+
+    Examples:
+
+      sarcli info raw.h5
+
+      sarcli info raw.h5 --json
+    """
+    s = summarize(path)
+    if as_json:
+        emit_json(s)
+    else:
+        _human(s)
+
+
+def register(app: typer.Typer) -> None:
+    app.command("info")(info)
