@@ -1,0 +1,22 @@
+"""Doppler centroid and Doppler rate estimation for stripmap raw data (issue 4).
+
+Modules, one job each:
+
+- ``cde``        lag-1 azimuth correlation per (azimuth block, range block): CDE and SDE kernels (numba),
+                 with plain-numpy references; per-block quality and SNR-aware validity flag.
+- ``rangecomp``  range compression (matched filter from the replica or the chirp parameters) used by the
+                 range-compressed CDE, MLCC/MLBF and map-drift.
+- ``ambiguity``  PRF ambiguity from a predicted absolute centroid, margins, the half-integer case,
+                 unwrapping of the baseband centroid over blocks.
+- ``polyfit``    weighted 2-D polynomial fit (range x azimuth) with outlier flags.
+- ``dataonly``   MLCC / MLBF data-only ambiguity resolution with an honest confidence.
+- ``geometry``   fdc and fr from orbit + attitude (full vector form and the seed's closed form eq. 6,
+                 look-angle inversion, exact -(2/lam) d2R/deta2).
+- ``mapdrift``   data-driven Doppler rate by map-drift autofocus.
+- ``model``      :class:`DopplerModel` (vectorized ``fdc(range, time)`` and ``fr(range, time)``).
+- ``api``        :func:`estimate_doppler` (contract 4).
+
+Sign conventions: a scatterer at one-way range R contributes exp(-j*4*pi*R/lam), so the Doppler
+frequency is f = -(2/lam) dR/deta, the centroid is positive when the beam looks forward (squint towards
+the flight direction), and the Doppler rate fr = -(2/lam) d2R/deta2 is negative for a side-looking radar.
+"""

@@ -1,0 +1,105 @@
+"""Weighted 2-D polynomial fit z(x, y) = sum_{i<=dx, j<=dy} c_ij x^i y^j with outlier flags.
+
+x, y are normalized coordinates (``Poly2D`` stores the offsets and scales, so evaluation takes physical
+range in m and azimuth time in s). Outliers: after a weighted least-squares fit, blocks whose residual
+exceeds ``k_sigma`` robust standard deviations (1.4826 * weighted MAD, floored at ``floor``) are
+flagged and the fit is repeated without them, until no new block is flagged. Flagged blocks are kept in
+the tables (with their flag), never silently used.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def poly2d_design(x: np.ndarray, y: np.ndarray, degree: tuple[int, int]) -> np.ndarray:
+    """Design matrix, columns x^i y^j for i in 0..dx, j in 0..dy (i outer)."""
+    x = np.asarray(x, float).ravel()
+    y = np.asarray(y, float).ravel()
+    cols = [x**i * y**j for i in range(degree[0] + 1) for j in range(degree[1] + 1)]
+    return np.stack(cols, axis=1)
+
+
+@dataclass
+class Poly2D:
+    """z = sum c[i, j] u^i v^j with u = (x - x0)/xs, v = (y - y0)/ys. Units of z as fitted."""
+
+    coef: np.ndarray  # (dx+1, dy+1)
+    x0: float
+    xs: float
+    y0: float
+    ys: float
+
+    def __call__(self, x, y) -> np.ndarray:
+        u = (np.asarray(x, float) - self.x0) / self.xs
+        v = (np.asarray(y, float) - self.y0) / self.ys
+        u, v = np.broadcast_arrays(u, v)
+        out = np.zeros(u.shape)
+        for i in range(self.coef.shape[0]):
+            for j in range(self.coef.shape[1]):
+                out = out + self.coef[i, j] * u**i * v**j
+        return out
+
+    def derivative_y(self, x, y) -> np.ndarray:
+        """dz/dy (physical units of y)."""
+        u = (np.asarray(x, float) - self.x0) / self.xs
+        v = (np.asarray(y, float) - self.y0) / self.ys
+        u, v = np.broadcast_arrays(u, v)
+        out = np.zeros(u.shape)
+        for i in range(self.coef.shape[0]):
+            for j in range(1, self.coef.shape[1]):
+                out = out + self.coef[i, j] * j * u**i * v ** (j - 1)
+        return out / self.ys
+
+    def to_dict(self) -> dict:
+        return {"coef": self.coef, "x0": self.x0, "xs": self.xs, "y0": self.y0, "ys": self.ys}
+
+
+def _norm(a: np.ndarray) -> tuple[float, float]:
+    lo, hi = float(np.min(a)), float(np.max(a))
+    return 0.5 * (lo + hi), max(0.5 * (hi - lo), 1e-12)
+
+
+def fit_poly2d(x: np.ndarray, y: np.ndarray, z: np.ndarray, w: np.ndarray, degree: tuple[int, int] = (2, 1),
+               k_sigma: float = 4.0, floor: float = 0.0, max_iter: int = 10) -> tuple[Poly2D, np.ndarray]:
+    """Weighted LSQ fit with iterative outlier rejection. Returns (poly, outlier_flags).
+
+    Degrees are reduced automatically when there are too few distinct x or y values (one range block
+    -> degree 0 in range). Blocks with zero/NaN weight or NaN z are ignored (not flagged).
+    """
+    x = np.asarray(x, float).ravel()
+    y = np.asarray(y, float).ravel()
+    z = np.asarray(z, float).ravel()
+    w = np.asarray(w, float).ravel()
+    use = np.isfinite(z) & np.isfinite(w) & (w > 0)
+    x0, xs = _norm(x)
+    y0, ys = _norm(y)
+    dx = min(degree[0], max(len(np.unique(x[use])) - 1, 0))
+    dy = min(degree[1], max(len(np.unique(y[use])) - 1, 0))
+    flags = np.zeros(z.shape, bool)
+    if not np.any(use):
+        return Poly2D(np.full((1, 1), np.nan), x0, xs, y0, ys), flags
+    A = poly2d_design((x - x0) / xs, (y - y0) / ys, (dx, dy))
+    zz = np.where(use, z, 0.0)
+    coef = np.zeros(A.shape[1])
+    for _ in range(max_iter):
+        m = use & ~flags
+        sw = np.sqrt(w[m])
+        coef, *_ = np.linalg.lstsq(A[m] * sw[:, None], zz[m] * sw, rcond=None)
+        res = zz - A @ coef
+        if m.sum() <= A.shape[1] + 2:
+            break
+        sigma = max(1.4826 * _weighted_median(np.abs(res[m]), w[m]), floor)
+        new = use & (np.abs(res) > k_sigma * sigma)
+        if np.array_equal(new, flags):
+            break
+        flags = new
+    return Poly2D(coef.reshape(dx + 1, dy + 1), x0, xs, y0, ys), flags
+
+
+def _weighted_median(a: np.ndarray, w: np.ndarray) -> float:
+    o = np.argsort(a)
+    cw = np.cumsum(w[o])
+    return float(a[o][np.searchsorted(cw, 0.5 * cw[-1])])
