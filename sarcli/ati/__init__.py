@@ -1,0 +1,6 @@
+"""SAR along-track interferometry (ATI) for ground moving targets (seed 001, issue 8).
+
+Modules: ``geometry`` (range history, Rs/Rm split, DRA ATI phase), ``unwrap`` (Itoh and
+dechirp-guided unwrapping), ``fit`` (weighted LS with covariance, error propagation),
+``estimate`` (seed / exact / nonlinear routes), ``nonlinear`` (full fit of the exact histories).
+"""

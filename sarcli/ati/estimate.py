@@ -1,0 +1,277 @@
+"""Mover parameters (vx, vy, x0, y0) from its two-channel slow-time signals (seed 001, §3).
+
+Input (:class:`SlowTime`): the slow-time signals of the mover's range bin in channel 0 (the
+monostatic channel, receiver on the transmitter, range history R(eta) of
+:mod:`sarcli.ati.geometry`) and channel 1 (receiver ``d`` along-track, already co-registered by
+``d/(2*Vp)``), the slow times ``eta`` (s from the reference time), the mover's closest-approach
+range ``r_min`` from its range position (m) and the platform.
+
+Data reduced from the signals:
+- the unwrapped phase psi0(eta) of channel 0: R(eta) = -lam/(4*pi)*psi0(eta) + const (the constant
+  is lost to the 2*pi ambiguity, so absolute range comes only from ``r_min``);
+- the ATI phase history phi(eta) = arg(s1*conj(s0)) = (4*pi/lam)*(d/(2*Vp))*vm(eta) - bistatic term,
+  with vm(eta) the mover-induced range rate (see geometry.py) and the bistatic term
+  (4*pi/lam)*d**2/(8*R) (half-sum of transmit and receive ranges exceeds the phase-centre range).
+
+Routes (knob ``route``):
+``seed``      the paper's chain with the printed typos fixed: quadratic LS at eta = 0 -> vR, aR;
+              R0 = r_min; vx = vr_los*R0/x0 from the mean ATI phase (neglects vy*y/R over the
+              aperture, as the paper does); vy = Vp - sqrt(R0*aR - vx^2) (eq. 15 with aR the full
+              second derivative; drops vR^2); azimuth angle phi = (vR/cos_g)/(vy - Vp) (eq. 17 with
+              cos_g = ground/slant range = sin(look), the printed cos(theta) uses an angle from the
+              horizontal) and x0 = R0*cos_g, y0 = R0*cos_g*phi (eq. 18-19, small angle; neglects
+              the vx*x0 term of vR).
+``exact``     (default) closed-form exact geometry: quadratic WLS at the weighted centre eta_m of the
+              data -> R'(eta_m), R''(eta_m); with r_min the hyperbola R^2 = r_min^2 + V2*(eta-eta_c)^2
+              follows exactly (R*R'' + R'^2 = V2, R^2 - (R*R')^2/V2 = r_min^2); R0, vR at eta = 0;
+              vm(0) from a quadratic fit of the ATI phase history; then y0 = R0*(vm - vR)/Vp (since
+              vR - vm = vs = -y0*Vp/R0), x0 = sqrt(R0^2 - H^2 - y0^2) on the look side, and vx, vy
+              from vR*R0 = vx*x0 + (vy - Vp)*y0 and vx^2 + (vy - Vp)^2 = V2.
+``nonlinear`` full weighted nonlinear LS of the exact (bistatic) range histories of both channels
+              to psi0(eta), phi(eta) and r_min, started from ``exact``.
+Every route returns 1-sigma uncertainties (propagated covariance, inflated by the reduced
+chi-square when the residuals exceed the noise model). vy is taken below Vp (a mover faster than the
+platform along-track is indistinguishable); when V2 <= vx^2 (vy -> Vp) the square root is clamped to
+0 and ``vy_degenerate`` is set instead of returning NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from sarcli.ati import fit as _fit
+from sarcli.ati.geometry import Mover, Platform, blind_speed, coefficients, los_rate_from_phase
+from sarcli.ati.unwrap import chirp_phase, dominant_chirp, unwrap, unwrap_slow
+from sarcli.errors import SarcliError
+
+ROUTES = ("seed", "exact", "nonlinear")
+#: the ATI velocity is reported ambiguous when |phase| + 3 sigma exceeds this fraction of pi: the
+#: measured phase is then close enough to the wrap that phase + 2*pi*k is a plausible truth.
+AMBIGUITY_FRACTION = 0.8
+#: samples whose normalized fit residual exceeds CLIP sigma are dropped and the fit repeated
+CLIP = 4.5
+
+
+@dataclass
+class SlowTime:
+    """Two-channel slow-time observation of one mover (see module docstring)."""
+
+    eta: np.ndarray
+    s0: np.ndarray
+    s1: np.ndarray
+    r_min: float
+    r_min_sigma: float
+    platform: Platform
+    baseline_m: float
+    look_sign: float = 1.0
+
+
+@dataclass
+class Estimate:
+    """Estimated mover at the reference time with 1-sigma uncertainties (SI units)."""
+
+    vx_mps: float
+    vy_mps: float
+    x0_m: float
+    y0_m: float
+    r0_m: float
+    vx_mps_sigma: float
+    vy_mps_sigma: float
+    x0_m_sigma: float
+    y0_m_sigma: float
+    r0_m_sigma: float
+    vr_mps: float
+    ar_mps2: float
+    route: str
+    vy_degenerate: bool = False
+    ati_phase_rad: float = 0.0
+    ati_ambiguous: bool = False
+    blind_speed_mps: float = 0.0
+    chi2_red: float = 1.0
+    extra: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class _Reduced:
+    """Unwrapped phase, ATI phase history and their weights."""
+
+    eta: np.ndarray
+    psi0: np.ndarray
+    w0: np.ndarray
+    phi: np.ndarray
+    w_ati: np.ndarray
+    sigma2: float
+
+
+def _reduce(obs: SlowTime, unwrap_method: str) -> _Reduced:
+    eta = np.asarray(obs.eta, np.float64)
+    s0 = np.asarray(obs.s0, np.complex128)
+    s1 = np.asarray(obs.s1, np.complex128)
+    if eta.shape != s0.shape or s0.shape != s1.shape or eta.size < 8:
+        raise SarcliError("slow-time signals must be 1-D, of equal length >= 8")
+    chirp = dominant_chirp(s0, eta)
+    psi0 = unwrap(s0, eta, unwrap_method, chirp)
+    model = chirp_phase(eta, chirp)
+    sigma2 = _fit.noise_power(s0 * np.exp(-1j * model))
+    w0 = _fit.phase_weights(s0, sigma2)
+    ati = s1 * np.conj(s0)
+    ref = np.angle(np.sum(ati * (w0 > 0)))
+    phi = unwrap_slow(ati * np.exp(-1j * ref)) + ref
+    phi -= 2.0 * np.pi * np.round((np.average(phi, weights=w0 + 1e-300) - ref) / (2.0 * np.pi))
+    sigma2_1 = _fit.noise_power(s1 * np.exp(-1j * model))
+    w1 = _fit.phase_weights(s1, sigma2_1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w_ati = np.where((w0 > 0) & (w1 > 0), 1.0 / (1.0 / np.maximum(w0, 1e-300) + 1.0 / np.maximum(w1, 1e-300)),
+                         0.0)
+    return _Reduced(eta, psi0, w0, phi, w_ati, sigma2)
+
+
+def _bistatic_phase(r: float, obs: SlowTime) -> float:
+    """ATI phase (rad) of the transmit/receive half-sum excess d^2/(8R) (channel 1 minus 0)."""
+    return -4.0 * np.pi / obs.platform.wavelength * obs.baseline_m ** 2 / (8.0 * r)
+
+
+def _hyperbola(b1: float, b2: float, r_min: float) -> tuple[float, float, float]:
+    """(rho = R(eta_m), V2, eta_m - eta_c) from R'(eta_m) = b1, R''(eta_m) = b2 and r_min."""
+    if b2 <= 0:
+        raise SarcliError("fitted range curvature is not positive: no mover signal in this range bin")
+    rho = r_min
+    for _ in range(50):
+        g = rho ** 3 * b2 - r_min ** 2 * (rho * b2 + b1 * b1)
+        dg = 3.0 * rho * rho * b2 - r_min ** 2 * b2
+        step = g / dg
+        rho -= step
+        if abs(step) < 1e-10 * r_min:
+            break
+    v2 = rho * b2 + b1 * b1
+    return rho, v2, rho * b1 / v2
+
+
+def _solve_velocities(r0: float, vr: float, y0: float, x0: float, v2: float, vp: float
+                      ) -> tuple[float, float, bool]:
+    """(vx, vy, degenerate) from vR*R0 = vx*x0 + u*y0 and vx^2 + u^2 = V2, u = vy - Vp < 0."""
+    a = 1.0 + (y0 / x0) ** 2
+    b = -2.0 * vr * r0 * y0 / x0 ** 2
+    c = (vr * r0 / x0) ** 2 - v2
+    disc = b * b - 4.0 * a * c
+    degenerate = disc <= 0.0
+    u = -b / (2.0 * a) if degenerate else (-b - math.sqrt(disc)) / (2.0 * a)
+    if u > 0.0:
+        u, degenerate = 0.0, True
+    vx = (vr * r0 - u * y0) / x0
+    return vx, u + vp, degenerate
+
+
+def _ground(r0: float, obs: SlowTime) -> float:
+    g2 = r0 * r0 - obs.platform.height ** 2
+    if g2 <= 0:
+        raise SarcliError(f"range {r0:.1f} m is shorter than the platform height {obs.platform.height:.1f} m")
+    return g2
+
+
+def _exact_map(x: np.ndarray, obs: SlowTime, eta_m: float) -> np.ndarray:
+    """(b1, b2, r_min, phi_m) at eta_m -> (vx, vy, x0, y0, R0, vR, aR, degenerate) at eta = 0.
+
+    At eta_m: rho = R, b1 = R', b2 = R''; vm = mover-induced range rate from the ATI phase phi_m;
+    the along-track separation Y = y_target - y_platform obeys vs = R' - vm = -Vp*Y/rho, the ground
+    distance X^2 = rho^2 - H^2 - Y^2, then vx, u from b1*rho = vx*X + u*Y and vx^2 + u^2 = V2;
+    finally x0 = X - vx*eta_m, y0 = Y - u*eta_m.
+    """
+    b1, b2, r_min, phi_m = x
+    p = obs.platform
+    rho, v2, _ = _hyperbola(b1, b2, r_min)
+    vm = float(los_rate_from_phase(phi_m - _bistatic_phase(rho, obs), obs.baseline_m, p))
+    y = rho * (vm - b1) / p.speed
+    g2 = _ground(rho, obs)
+    xg = obs.look_sign * math.sqrt(max(g2 - y * y, 0.0))
+    if xg == 0.0:
+        raise SarcliError("estimated along-track offset exceeds the ground range: inconsistent data")
+    vx, vy, deg = _solve_velocities(rho, b1, y, xg, v2, p.speed)
+    x0 = xg - vx * eta_m
+    y0 = y - (vy - p.speed) * eta_m
+    c = coefficients(Mover(x0, y0, vx, vy), p)
+    return np.array([vx, vy, x0, y0, c.r0, c.vr, c.ar, float(deg)])
+
+
+def _seed_map(x: np.ndarray, obs: SlowTime) -> np.ndarray:
+    """(vR, aR, r_min, mean ATI phase) -> (vx, vy, x0, y0, R0, vR, aR, degenerate), paper's chain."""
+    vr, ar, r0, phi = x
+    p = obs.platform
+    cos_g = math.sqrt(_ground(r0, obs)) / r0
+    vr_los = float(los_rate_from_phase(phi - _bistatic_phase(r0, obs), obs.baseline_m, p))
+    vx = obs.look_sign * vr_los / cos_g
+    arg = r0 * ar - vx * vx
+    deg = arg <= 0.0
+    vy = p.speed - math.sqrt(max(arg, 0.0))
+    u = vy - p.speed
+    az = (vr / cos_g) / u if u != 0.0 else 0.0
+    x0 = obs.look_sign * r0 * cos_g
+    return np.array([vx, vy, x0, r0 * cos_g * az, r0, vr, ar, float(deg)])
+
+
+def _finish(route: str, y: np.ndarray, cov: np.ndarray, obs: SlowTime, phi_mean: float,
+            chi2: float, extra: dict) -> Estimate:
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    vb = blind_speed(obs.baseline_m, obs.platform)
+    phi_sd = extra.get("ati_phase_sigma_rad", 0.0)
+    return Estimate(
+        vx_mps=float(y[0]), vy_mps=float(y[1]), x0_m=float(y[2]), y0_m=float(y[3]), r0_m=float(y[4]),
+        vx_mps_sigma=float(sd[0]), vy_mps_sigma=float(sd[1]), x0_m_sigma=float(sd[2]),
+        y0_m_sigma=float(sd[3]), r0_m_sigma=float(sd[4]), vr_mps=float(y[5]), ar_mps2=float(y[6]),
+        route=route, vy_degenerate=bool(y[7] > 0.5), ati_phase_rad=float(phi_mean),
+        ati_ambiguous=bool(abs(phi_mean) + 3.0 * phi_sd > AMBIGUITY_FRACTION * np.pi), blind_speed_mps=vb,
+        chi2_red=float(chi2), extra=extra)
+
+
+def estimate(obs: SlowTime, route: str = "exact", unwrap_method: str = "dechirp",
+             degree: int = 4) -> Estimate:
+    """Estimate the mover's parameters by ``route`` (see module docstring).
+
+    ``degree`` is the polynomial degree of the range-history fit of the ``exact`` route (2 = the
+    seed's quadratic; 4 removes the quartic-term bias of R'' over long apertures). The ``seed``
+    route always fits the seed's quadratic.
+    """
+    if route not in ROUTES:
+        raise SarcliError(f"unknown estimation route {route!r}; choose one of {', '.join(ROUTES)}")
+    red = _reduce(obs, unwrap_method)
+    lam = obs.platform.wavelength
+    rng = -lam / (4.0 * np.pi) * red.psi0
+    w_rng = red.w0 * (4.0 * np.pi / lam) ** 2
+    used = red.w0 > 0
+    phi_mean = float(np.angle(np.sum(np.exp(1j * red.phi) * red.w_ati)))
+    wsum = float(np.sum(red.w_ati))
+    phi_sd = 1.0 / math.sqrt(wsum) if wsum > 0 else float("inf")
+    extra = {"ati_phase_sigma_rad": phi_sd, "n_used": int(used.sum()), "noise_power": red.sigma2,
+             "unwrap": unwrap_method}
+    if route == "seed":
+        q = _fit.wls_poly(red.eta, rng, w_rng, 2, clip=CLIP)
+        # phase mean with the bistatic term of the seed's R0 (= r_min) removed inside _seed_map
+        x = np.array([q.coef[1], 2.0 * q.coef[2], obs.r_min, phi_mean])
+        cx = np.zeros((4, 4))
+        cx[0:2, 0:2] = q.cov[1:3, 1:3] * np.array([[1.0, 2.0], [2.0, 4.0]])
+        cx[2, 2] = obs.r_min_sigma ** 2
+        cx[3, 3] = phi_sd ** 2
+        y, cov = _fit.propagate(lambda v: _seed_map(v, obs), x, cx)
+        return _finish(route, y, cov, obs, phi_mean, q.chi2_red, extra)
+    eta_m = float(np.average(red.eta, weights=red.w0 + 1e-300))
+    q = _fit.wls_poly(red.eta - eta_m, rng, w_rng, degree, clip=CLIP)
+    qa = _fit.wls_poly(red.eta - eta_m, red.phi, red.w_ati, 2, clip=CLIP)
+    x = np.array([q.coef[1], 2.0 * q.coef[2], obs.r_min, qa.coef[0]])
+    cx = np.zeros((4, 4))
+    cx[0:2, 0:2] = q.cov[1:3, 1:3] * np.array([[1.0, 2.0], [2.0, 4.0]])
+    cx[2, 2] = obs.r_min_sigma ** 2
+    cx[3, 3] = qa.cov[0, 0]
+    y, cov = _fit.propagate(lambda v: _exact_map(v, obs, eta_m), x, cx)
+    chi2 = max(q.chi2_red, qa.chi2_red)
+    if route == "exact":
+        return _finish(route, y, cov, obs, phi_mean, chi2, extra)
+    from sarcli.ati.nonlinear import fit_exact_history
+
+    y, cov, chi2 = fit_exact_history(obs, red.eta, red.psi0, red.w0, red.phi, red.w_ati, y)
+    return _finish(route, y, cov, obs, phi_mean, chi2, extra)
