@@ -106,7 +106,7 @@ def read_matlab_block(data_path: str | os.PathLike, params_path: str | os.PathLi
     echo = np.asarray(mat[name])
     if echo.ndim != 2 or not np.issubdtype(echo.dtype, np.number):
         raise FormatError(f"{data_path}: variable '{name}' is not a 2-D numeric array (shape {echo.shape})")
-    echo = echo.astype(np.complex64)
+    echo = np.ascontiguousarray(echo, dtype=np.complex64)
     if not np.all(np.isfinite(echo.view(np.float32))):
         raise FormatError(f"{data_path}: variable '{name}' contains NaN or inf")
 

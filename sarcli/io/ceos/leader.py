@@ -115,6 +115,9 @@ def parse_leader(buf: bytes, src: str) -> LeaderInfo:
     if len(buf) < F.HEADER_BYTES:
         raise FormatError(f"{src}: not a CEOS leader file (only {len(buf)} bytes)")
     first = F.parse_header(buf, 0)
+    if first.codes == F.CODES_FILE_DESCRIPTOR and first.length != FILE_DESCRIPTOR_BYTES:
+        raise FormatError(f"{src}: not a CEOS leader file (its file descriptor is {first.length} bytes, a "
+                          f"leader's is {FILE_DESCRIPTOR_BYTES}; leader and data swapped?)")
     if first.codes != F.CODES_FILE_DESCRIPTOR or first.length != FILE_DESCRIPTOR_BYTES \
             or F.ascii_field(buf, 17, 28) != "CEOS-SAR-CCT":
         raise FormatError(f"{src}: not a CEOS leader file (no CEOS-SAR-CCT file descriptor record)")
