@@ -55,5 +55,180 @@ def simulate_cmd(
              f"{', '.join(sorted(sc.effects)) or 'none'}")
 
 
+def _scan_or_scene_system(path: Path, max_range: float | None, criterion_deg: float):
+    """Table 1 of a scene TOML or a scan product."""
+    import math
+
+    from sarcli.gbsar.system import build_system
+
+    if path.suffix.lower() == ".toml":
+        from sarcli.gbsar.scene import load_scene
+
+        sc = load_scene(path)
+        f, x, lx = sc.frequencies(), sc.positions_m, sc.antenna.length_azimuth_m
+        max_range = max_range if max_range is not None else sc.processing.get("max_range_m")
+    else:
+        from sarcli.io.scan import read_scan
+
+        s = read_scan(path)
+        f, x, lx = s.frequency, s.rail_position, s.antenna.length_azimuth_m
+    return build_system(f, x, lx, max_range, math.radians(criterion_deg))
+
+
+@gbsar_app.command("plan")
+def plan_cmd(
+    source: Path = typer.Argument(..., help="Scene TOML or scan product (.h5)."),
+    max_range: float = typer.Option(None, "--max-range", help="Image range Rc (m) for RD's N_xfft [default: "
+                                    "the scene's processing.max_range_m, else R_max]."),
+    criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg), eq. 12."),
+    json_out: bool = typer.Option(False, "--json", help="Print the table as JSON on stdout."),
+) -> None:
+    """Print the derived system table (seed 000 Table 1), the DF minimum range and resolution by region.
+
+    Examples:
+
+      sarcli gbsar plan samples/gbsar_outdoor.toml
+
+      sarcli gbsar plan scan.h5 --json
+    """
+    from sarcli.gbsar.system import azimuth_resolution
+
+    sysp = _scan_or_scene_system(source, max_range, criterion_deg)
+    d = sysp.as_dict()
+    top = sysp.r_max_m if sysp.r_max_m < float("inf") else 1000.0
+    probes = sorted({r for r in (1, 2, 5, 10, 20, 50, 100, 200, 400, 600) if r <= top} | {round(top, 3)})
+    regions = []
+    for r0 in probes:
+        for xc in (0.0, sysp.rail_length_m / 2 + sysp.wavelength_m * r0 / (2 * sysp.antenna_length_azimuth_m) / 2):
+            reg, rd = azimuth_resolution(r0, xc, sysp.rail_length_m, sysp.wavelength_m, sysp.antenna_length_azimuth_m)
+            _, df = azimuth_resolution(r0, xc, sysp.rail_length_m, sysp.wavelength_m,
+                                       sysp.antenna_length_azimuth_m, "df")
+            regions.append({"r0_m": r0, "xc_m": xc, "region": reg, "rd_resolution_m": rd, "df_resolution_m": df})
+    d["resolution_by_region"] = regions
+    if json_out:
+        emit_json(d)
+        return
+    mb = 1024 * 1024
+    lines = [
+        f"centre frequency f_c       {sysp.center_frequency_hz / 1e9:.4g} GHz (lambda {sysp.wavelength_m:.4f} m)",
+        f"bandwidth B_R, N_R         {sysp.bandwidth_hz / 1e6:.4g} MHz, {sysp.n_r}",
+        f"range resolution dR        {_fmt(sysp.range_resolution_m)} m",
+        f"frequency step df          {_fmt(sysp.frequency_step_hz)} Hz",
+        f"R_max = c/(4 df)           {_fmt(sysp.r_max_m)} m",
+        f"N_Rfft, range pixel        {sysp.n_rfft}, {_fmt(sysp.range_pixel_m)} m (Table 1 formula "
+        f"{_fmt(sysp.range_pixel_paper_m)} m)",
+        f"rail X, dx, N_x            {sysp.rail_length_m:.4g} m, {_fmt(sysp.rail_step_m)} m, {sysp.n_x}"
+        + ("" if sysp.rail_uniform else " (NON-UNIFORM steps: BP only)"),
+        f"N_xfft DF / RD             {sysp.n_xfft_df} / {sysp.n_xfft_rd} (RD for Rc = {sysp.image_max_range_m:.4g} m)",
+        f"DF azimuth pixel, width    {_fmt(sysp.df_azimuth_pixel_per_rc)} Rc, {_fmt(sysp.df_azimuth_width_per_rc)} Rc",
+        f"RD azimuth pixel, width    {_fmt(sysp.rd_azimuth_pixel_m)} m, {_fmt(sysp.rd_azimuth_width_m)} m",
+        f"u_R                        {sysp.doppler_rate_coefficient:.4g}/R0 1/m^2",
+        f"memory DF / RD             {sysp.memory_df_bytes / mb:.3g} MB / "
+        f"{(sysp.memory_rd_bytes or 0) / mb:.4g} MB (raw {sysp.raw_bytes / mb:.3g} MB)",
+        f"DF minimum range (eq. 12)  {sysp.df_min_range_m:.4g} m at criterion {criterion_deg:g} deg",
+        "resolution by region (R0, xc -> region, RD, DF):",
+    ]
+    lines += [f"  {g['r0_m']:>8.4g} m {g['xc_m']:>8.3g} m  {g['region']:>3}  {g['rd_resolution_m']:.3g} m  "
+              f"{g['df_resolution_m']:.3g} m" for g in regions]
+    typer.echo("\n".join(lines))
+
+
+def _fmt(v) -> str:
+    return "n/a" if v is None else f"{v:.4g}"
+
+
+@gbsar_app.command("focus")
+def focus_cmd(
+    scan: Path = typer.Argument(..., help="Scan product (.h5)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Output image product (.h5)."),
+    algorithm: str = typer.Option("auto", "--algorithm", help="auto | df | rd | bp."),
+    pol: list[str] = typer.Option(None, "--pol", help="Polarization(s) to focus [default: all]."),
+    max_range: float = typer.Option(None, "--max-range", help="Largest image range R0 (m) [default: R_max]."),
+    min_range: float = typer.Option(0.0, "--min-range", help="Smallest image range R0 (m)."),
+    pixel_x: float = typer.Option(None, "--pixel-x", help="Azimuth pixel (m), a multiple of the rail step "
+                                  "[default: about half the range pixel]."),
+    width: float = typer.Option(None, "--width", help="Azimuth width of the image (m) [default: beam "
+                                "footprint at the top range plus the rail, at most DF's width]."),
+    criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg) for auto."),
+    near: str = typer.Option("bp", "--near", help="auto's near-range algorithm: bp | rd."),
+    n_xfft: int = typer.Option(None, "--n-xfft", help="Azimuth FFT size for DF/RD [default: the paper's rule]."),
+    range_window: str = typer.Option("hamming", "--range-window", help="hamming | hann | none."),
+    azimuth_window: str = typer.Option("hamming", "--azimuth-window", help="hamming | hann | none."),
+    geotiff: Path = typer.Option(None, "--geotiff", help="Amplitude (dB) GeoTIFF in UTM of the first polarization."),
+    enu_geotiff: Path = typer.Option(None, "--enu-geotiff", help="Amplitude (dB) GeoTIFF in local ENU."),
+    map_pixel: float = typer.Option(None, "--map-pixel", help="Map pixel (m) of the GeoTIFFs [default: range pixel]."),
+    ground_height: float = typer.Option(0.0, "--ground-height", help="Surface height z (m) for geocoding."),
+    quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the slant-plane amplitude."),
+    json_out: bool = typer.Option(False, "--json", help="Print the focusing report as JSON on stdout."),
+) -> None:
+    """Focus a scan: range compression, then DF, RD, BP or auto (DF beyond the eq. 12 limit, BP/RD nearer).
+
+    The image lies in the slant plane of the rail (range R0 from the rail line, azimuth x along it);
+    its phase at a scatterer is -4*pi*R0/lambda for every algorithm.
+
+    Examples:
+
+      sarcli gbsar focus scan.h5 -o image.h5 --geotiff image.tif --quicklook image.png
+
+      sarcli gbsar focus scan.h5 --algorithm rd --max-range 15 -o near.h5 --json
+    """
+    import math
+
+    import numpy as np
+
+    from sarcli.gbsar.focus import FocusOptions, focus_scan
+    from sarcli.io.gbsar_image import GbsarImage, write_gbsar_image
+    from sarcli.io.scan import read_scan
+
+    s = read_scan(scan)
+    opts = FocusOptions(algorithm=algorithm, range_window=range_window, azimuth_window=azimuth_window,
+                        max_range_m=max_range, min_range_m=min_range, pixel_x_m=pixel_x, width_m=width,
+                        criterion_rad=math.radians(criterion_deg), near=near, n_xfft=n_xfft)
+    pols = tuple(p.upper() for p in pol) if pol else None
+    for p in pols or ():
+        s.pol(p)
+    f = focus_scan(s, opts, pols=pols)
+    img = GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
+                     polarizations=tuple(f.report["polarizations"]), algorithm=algorithm,
+                     center_frequency_hz=float(0.5 * (s.frequency[0] + s.frequency[-1])),
+                     frequency_step_hz=float((s.frequency[-1] - s.frequency[0]) / (s.frequency.size - 1)),
+                     n_freq=int(s.frequency.size), rail_height_m=float(np.mean(s.rail_height)),
+                     rail_centre_m=float(0.5 * (s.rail_position[0] + s.rail_position[-1])),
+                     rail_length_m=float(s.rail_position[-1] - s.rail_position[0]), epoch_utc=s.epoch_utc,
+                     scan_time_s=float(np.mean(s.stop_time)) if s.stop_time is not None else 0.0,
+                     site=s.site, report=f.report)
+    write_gbsar_image(output, img, parameters=vars(opts), inputs=[scan])
+    _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quicklook, f.report)
+    if f.report["skipped_stops"]:
+        info(f"warning: skipped {len(f.report['skipped_stops'])} flagged/NaN stop(s): {f.report['skipped_stops']}")
+    if json_out:
+        emit_json(f.report)
+    else:
+        used = ", ".join(f"{k} {a:.2f}-{b:.2f} m" for k, (a, b) in f.report["used"].items())
+        info(f"wrote {output}: {img.image.shape[1]} x {img.image.shape[2]} pixels, {used} "
+             f"(DF minimum range {f.report['df_min_range_m']:.2f} m)")
+
+
+def _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quicklook, report) -> None:
+    """GeoTIFFs (UTM / ENU) and the quicklook of the first polarization's amplitude in dB."""
+    from sarcli.gbsar.geocode import resample_to_map
+    from sarcli.io.images import amplitude_db, write_geotiff, write_quicklook
+
+    db = amplitude_db(img.image[0], floor_db=-200.0)
+    pixel = map_pixel or float(img.range_m[1] - img.range_m[0]) if img.range_m.size > 1 else 1.0
+    for path, frame in ((geotiff, "utm"), (enu_geotiff, "enu")):
+        if path is None:
+            continue
+        raster, transform, crs, ginfo = resample_to_map(db, img.range_m, img.azimuth_m, img.site, img.rail_height_m,
+                                                        img.rail_centre_m, pixel, frame, ground_height)
+        report[f"{frame}_geotiff"] = {"path": str(path), "crs": crs, "shape": list(raster.shape), **ginfo}
+        write_geotiff(path, raster, crs, transform=transform, band_description=f"{img.polarizations[0]} amplitude (dB)",
+                      tags={"algorithm": img.algorithm, "epoch_utc": img.epoch_utc, "units": "dB"})
+    if quicklook is not None:
+        write_quicklook(quicklook, img.image[0], title=f"GB-SAR {img.polarizations[0]} ({img.algorithm})",
+                        extent=[img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]],
+                        xlabel="azimuth x (m)", ylabel="range R0 (m)", aspect="auto")
+
+
 def register(app: typer.Typer) -> None:
     attach(app)

@@ -1,0 +1,106 @@
+"""The focused GB-SAR image product (``product_type = "gbsar_image"``), schema version 1.
+
+Layout (SI units)::
+
+    /                 provenance, epoch_utc, polarizations, algorithm, center_frequency_hz,
+                      frequency_step_hz, n_freq, rail_height_m (mean antenna height), rail_centre_m,
+                      rail_length_m, scan_time_s (mean stop time after epoch), report (JSON),
+                      phase_convention = "-4*pi*R0/lambda"
+    /image            complex64 (n_pol, n_range, n_azimuth): slant-plane image
+    /range            float64 (n_range,) m, R0 = distance from the rail line (image plane through the rail)
+    /azimuth          float64 (n_azimuth,) m, x along the rail (scan frame)
+    /algorithm_map    uint8 (n_range, n_azimuth): 0 not covered, 1 DF, 2 RD, 3 BP
+    /site             attributes of the scan's site (rail centre geodetic position, heading, look side)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sarcli.errors import ProductError
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.scan import Site
+
+PRODUCT_TYPE = "gbsar_image"
+SCHEMA_VERSION = "1"
+
+
+@dataclass
+class GbsarImage:
+    image: np.ndarray
+    range_m: np.ndarray
+    azimuth_m: np.ndarray
+    algorithm_map: np.ndarray
+    polarizations: tuple[str, ...]
+    algorithm: str
+    center_frequency_hz: float
+    frequency_step_hz: float
+    n_freq: int
+    rail_height_m: float
+    rail_centre_m: float
+    rail_length_m: float
+    epoch_utc: str
+    scan_time_s: float
+    site: Site = field(default_factory=Site)
+    report: dict[str, Any] = field(default_factory=dict)
+
+    def pol(self, name: str) -> np.ndarray:
+        if name not in self.polarizations:
+            raise ProductError(f"image has polarizations {','.join(self.polarizations)}, not {name}")
+        return self.image[self.polarizations.index(name)]
+
+    @property
+    def wavelength_m(self) -> float:
+        from sarcli.gbsar import C_LIGHT
+
+        return C_LIGHT / self.center_frequency_hz
+
+
+_SCALARS = ("algorithm", "center_frequency_hz", "frequency_step_hz", "n_freq", "rail_height_m", "rail_centre_m",
+            "rail_length_m", "epoch_utc", "scan_time_s")
+
+
+def write_gbsar_image(path: str | os.PathLike, img: GbsarImage, parameters: dict | None = None,
+                      inputs: tuple = ()) -> None:
+    if img.image.ndim != 3 or img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size):
+        raise ProductError(f"{path}: image shape {img.image.shape} does not match its axes")
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
+        for k in _SCALARS:
+            f.attrs[k] = getattr(img, k)
+        f.attrs["polarizations"] = ",".join(img.polarizations)
+        f.attrs["report"] = json.dumps(img.report, sort_keys=True, default=float)
+        f.attrs["phase_convention"] = "-4*pi*R0/lambda"
+        dataset(f, "image", np.asarray(img.image, np.complex64), units="1", chunks=True, compression="gzip")
+        dataset(f, "range", np.asarray(img.range_m, np.float64), units="m")
+        dataset(f, "azimuth", np.asarray(img.azimuth_m, np.float64), units="m")
+        dataset(f, "algorithm_map", np.asarray(img.algorithm_map, np.uint8), units="1", compression="gzip")
+        g = group(f, "site")
+        for k, v in vars(img.site).items():
+            g.attrs[k] = v
+
+
+def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
+    with open_product(path, PRODUCT_TYPE) as f:
+        if attr_str(f, "schema_version") != SCHEMA_VERSION:
+            raise ProductError(f"{path}: unsupported gbsar_image schema version")
+        missing = [k for k in _SCALARS if k not in f.attrs]
+        if missing:
+            raise ProductError(f"{path}: malformed gbsar_image, missing attribute(s) {', '.join(missing)}")
+        vals = {k: (attr_str(f, k) if k in ("algorithm", "epoch_utc") else f.attrs[k].item()) for k in _SCALARS}
+        site = Site(**{k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
+                       for k, v in f["site"].attrs.items()}) if "site" in f else Site()
+        img = GbsarImage(
+            image=require(f, "image", path, shape_rank=3, dtype_kind="c")[()],
+            range_m=require(f, "range", path, shape_rank=1)[()],
+            azimuth_m=require(f, "azimuth", path, shape_rank=1)[()],
+            algorithm_map=require(f, "algorithm_map", path, shape_rank=2)[()],
+            polarizations=tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p),
+            site=site, report=json.loads(attr_str(f, "report") or "{}"), **vals)
+    if img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size) or img.image.shape[0] != len(img.polarizations):
+        raise ProductError(f"{path}: malformed gbsar_image, image shape does not match its axes")
+    return img
