@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from orbit.errors import InterpolationRangeError, StateVectorError
+from orbit.frames import ecef_to_eci, eci_to_ecef
 
 FRAMES = ("ECI", "ECEF", "LOCAL")
 DEFAULT_N_NODES = 10  # from the accuracy/cost table (docs/readme/30-orbit.md): 10x margin on both bars
@@ -195,6 +196,7 @@ class StateVectors:
         self.time, self.position, self.velocity = t, p, v
         self.frame, self.epoch_utc = frame, str(epoch_utc)
         self._tables: dict[int, tuple] = {}
+        self._ecef: StateVectors | None = None
 
     @classmethod
     def from_record(cls, orbit, epoch_utc: str) -> StateVectors:
@@ -271,20 +273,18 @@ class StateVectors:
         return tuple(o.reshape(ta.shape + (3,)) for o in out)
 
     def to_ecef(self) -> StateVectors:
-        """These state vectors in ECEF (rotation by GMST, velocity with the w x r term; orbit.frames)."""
+        """These state vectors in ECEF (rotation by GMST, velocity with the w x r term; orbit.frames); cached."""
         if self.frame == "ECEF":
             return self
-        from orbit.frames import eci_to_ecef
-
-        r, v = eci_to_ecef(self._epoch_for(self.frame), self.time, self.position, self.velocity)
-        return StateVectors(self.time, r, v, "ECEF", self.epoch_utc)
+        if self._ecef is None:
+            r, v = eci_to_ecef(self._epoch_for(self.frame), self.time, self.position, self.velocity)
+            self._ecef = StateVectors(self.time, r, v, "ECEF", self.epoch_utc)
+        return self._ecef
 
     def to_eci(self) -> StateVectors:
         """These state vectors in the GMST inertial frame (inverse of :meth:`to_ecef`)."""
         if self.frame == "ECI":
             return self
-        from orbit.frames import ecef_to_eci
-
         r, v = ecef_to_eci(self._epoch_for(self.frame), self.time, self.position, self.velocity)
         return StateVectors(self.time, r, v, "ECI", self.epoch_utc)
 
