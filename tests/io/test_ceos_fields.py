@@ -146,3 +146,16 @@ def test_blank_fields_are_missing_not_zero():
 def test_record_header_roundtrip():
     h = F.parse_header(F.pack_header(7, F.CODES_SIGNAL_DATA, 18818))
     assert (h.sequence, h.codes, h.length) == (7, (50, 10, 18, 20), 18818)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.sampled_from([-15.0, -3.0, -1.0, 1.0, 7.0, 15.0, 0.0, 2.0, 17.0, -17.0, 1.5, np.nan, np.inf]),
+                min_size=2, max_size=12).filter(lambda v: len(v) % 2 == 0),
+       st.sampled_from([np.complex64, np.complex128]))
+def test_four_bit_check_matches_reference(vals, dtype):
+    from sarcli.io.ceos.samples import is_four_bit, is_four_bit_reference
+
+    x = np.empty(len(vals) // 2, dtype)
+    x.real, x.imag = vals[0::2], vals[1::2]
+    assert is_four_bit(x) == is_four_bit_reference(x)
+    assert not is_four_bit(np.ones(4))  # real arrays are not I/Q levels
