@@ -1,0 +1,22 @@
+"""earth_rotation: targets are fixed to the rotating Earth (ECEF); without it the scene is inertial.
+
+Inertial scene: every target keeps its ECI position at the scene-centre time. With Earth
+rotation, p_eci(t) = Rz(theta(t))^T p_ecef with theta the GMST angle (orbit.frames).
+"""
+
+from sarcli.errors import FormatError
+
+NAME = "earth_rotation"
+DOC = "targets fixed to the rotating Earth (else inertial)"
+
+
+def parse(table, platform):
+    from sarcli.sim.scene import LinearPlatform
+
+    if isinstance(platform, LinearPlatform):
+        raise FormatError("effect earth_rotation needs an orbit or state_vectors platform (flat-Earth scene)")
+    return None
+
+
+def configure(ctx, params):
+    ctx.earth_rotation = True

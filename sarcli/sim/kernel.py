@@ -1,0 +1,172 @@
+"""Echo kernels: numba (production) and a plain-numpy reference of the same physics (tests, bench).
+
+Signal of target i in pulse k, channel c (stop-and-hop: platform frozen at r_k while the pulse
+travels; times relative to the scene centre):
+
+    p_k     = M_k (q_i + u_i (t_k - t_ref_i))                     target in the simulation frame
+    R_tx    = |p_k - r_k|,  R_rx = |p_k - (r_k + off_c x_k)|,  R_c = (R_tx + R_rx)/2
+    R_env   = R_c with range_migration, else R0_i (closest approach)
+    s[c, k, n] += a_i G_ik exp(-j 4 pi R_c / lam) exp(+j pi K tau^2),  tau = ws + n/fs - 2 R_env/c,
+                  for the samples with |tau| <= T/2 only (pulse centred on its delay)
+    G_ik    = sinc^2(L_az sin(psi_az)/lam) sinc^2(L_el sin(psi_el)/lam) with antenna_pattern, else 1,
+              sin(psi_az) = d.x_k/|d|, sin(psi_el) = d.e_k/|d|
+
+Only the pulses with |sin(psi_az)| <= smax (the processed beam, found by bisection since
+sin(psi_az) decreases monotonically as the target passes) and only the samples inside the pulse
+are computed. Cost model: sum over targets of (pulses in beam) x (T fs samples) x (channels),
+about 2 complex multiply-adds per sample (the chirp phasor is advanced by recurrence:
+z_{n+1} = z_n w_n, w_{n+1} = w_n exp(j 2 pi K dt^2), exact in exact arithmetic, drift ~1e-13 in
+float64 over a pulse), plus O(log n_lines) per target for the beam search. Parallel over blocks of
+lines (each block owns its output lines: no write races).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+C = 299792458.0
+
+
+@njit(cache=True, inline="always")
+def _target_at(rot, k, tp, tv, i, dt, out):
+    q0 = tp[i, 0] + tv[i, 0] * dt
+    q1 = tp[i, 1] + tv[i, 1] * dt
+    q2 = tp[i, 2] + tv[i, 2] * dt
+    for j in range(3):
+        out[j] = rot[k, j, 0] * q0 + rot[k, j, 1] * q1 + rot[k, j, 2] * q2
+
+
+@njit(cache=True)
+def _sin_az(t, rp, ux, rot, tp, tv, tref, i, k, buf):
+    _target_at(rot, k, tp, tv, i, t[k] - tref[i], buf)
+    d0 = buf[0] - rp[k, 0]
+    d1 = buf[1] - rp[k, 1]
+    d2 = buf[2] - rp[k, 2]
+    return (d0 * ux[k, 0] + d1 * ux[k, 1] + d2 * ux[k, 2]) / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@njit(cache=True, parallel=True)
+def beam_windows(t, rp, ux, rot, tp, tv, tref, smax):  # pragma: no cover - compiled
+    """[k0, k1) per target: the pulses with |sin(psi_az)| <= smax (bisection on a decreasing function)."""
+    n_t = tp.shape[0]
+    n = t.shape[0]
+    k0 = np.empty(n_t, np.int64)
+    k1 = np.empty(n_t, np.int64)
+    for i in prange(n_t):
+        buf = np.empty(3)
+        lo, hi = 0, n
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if _sin_az(t, rp, ux, rot, tp, tv, tref, i, mid, buf) <= smax:
+                hi = mid
+            else:
+                lo = mid + 1
+        k0[i] = lo
+        hi = n
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if _sin_az(t, rp, ux, rot, tp, tv, tref, i, mid, buf) < -smax:
+                hi = mid
+            else:
+                lo = mid + 1
+        k1[i] = lo
+    return k0, k1
+
+
+@njit(cache=True, inline="always")
+def _sinc2(x):
+    if x == 0.0:
+        return 1.0
+    y = math.pi * x
+    s = math.sin(y) / y
+    return s * s
+
+
+@njit(cache=True, parallel=True)
+def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
+                migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
+    """Accumulate every target's echo into out (n_channels, n_lines, n_samples); see the module docstring."""
+    n_ch, n_lines, n_s = out.shape
+    n_t = tp.shape[0]
+    n_blocks = (n_lines + block - 1) // block
+    dts = 1.0 / fs
+    ww_arg = 2.0 * math.pi * kr * dts * dts
+    ww = complex(math.cos(ww_arg), math.sin(ww_arg))
+    for b in prange(n_blocks):
+        a0 = b * block
+        a1 = min(n_lines, a0 + block)
+        p = np.empty(3)
+        for i in range(n_t):
+            lo = max(k0[i], a0)
+            hi = min(k1[i], a1)
+            for k in range(lo, hi):
+                _target_at(rot, k, tp, tv, i, t[k] - tref[i], p)
+                d0 = p[0] - rp[k, 0]
+                d1 = p[1] - rp[k, 1]
+                d2 = p[2] - rp[k, 2]
+                rtx = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                g = 1.0
+                if pattern:
+                    sa = (d0 * ux[k, 0] + d1 * ux[k, 1] + d2 * ux[k, 2]) / rtx
+                    se = (d0 * ue[k, 0] + d1 * ue[k, 1] + d2 * ue[k, 2]) / rtx
+                    g = _sinc2(laz * sa) * _sinc2(lel * se)
+                for c in range(n_ch):
+                    off = rx_off[c]
+                    rc = rtx
+                    if off != 0.0:
+                        e0 = d0 - off * ux[k, 0]
+                        e1 = d1 - off * ux[k, 1]
+                        e2 = d2 - off * ux[k, 2]
+                        rc = 0.5 * (rtx + math.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
+                    renv = rc if migrate else r0[i]
+                    td = 2.0 * renv / C
+                    n_lo = max(0, math.ceil((td - 0.5 * plen - ws) * fs))
+                    n_hi = min(n_s - 1, math.floor((td + 0.5 * plen - ws) * fs))
+                    if n_hi < n_lo:
+                        continue
+                    ph = -4.0 * math.pi * rc / lam
+                    z0 = amp[i] * g * complex(math.cos(ph), math.sin(ph))
+                    tau = ws + n_lo * dts - td
+                    a = math.pi * kr * tau * tau
+                    z = z0 * complex(math.cos(a), math.sin(a))
+                    wa = math.pi * kr * (2.0 * tau * dts + dts * dts)
+                    w = complex(math.cos(wa), math.sin(wa))
+                    for n in range(n_lo, n_hi + 1):
+                        out[c, k, n] += z
+                        z *= w
+                        w *= ww
+
+
+def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
+                   migrate, pattern, laz, lel):
+    """Plain-numpy reference of :func:`echo_kernel` (same arguments, no block): vectorized per target."""
+    n_ch, n_lines, n_s = out.shape
+    for i in range(tp.shape[0]):
+        ks = np.arange(k0[i], k1[i])
+        if ks.size == 0:
+            continue
+        q = tp[i] + tv[i] * (t[ks] - tref[i])[:, None]
+        p = np.einsum("kij,kj->ki", rot[ks], q)
+        d = p - rp[ks]
+        rtx = np.linalg.norm(d, axis=1)
+        g = np.ones_like(rtx)
+        if pattern:
+            sa = np.einsum("ki,ki->k", d, ux[ks]) / rtx
+            se = np.einsum("ki,ki->k", d, ue[ks]) / rtx
+            g = np.sinc(laz * sa) ** 2 * np.sinc(lel * se) ** 2
+        for c in range(n_ch):
+            rc = rtx if rx_off[c] == 0 else 0.5 * (rtx + np.linalg.norm(d - rx_off[c] * ux[ks], axis=1))
+            renv = rc if migrate else np.full_like(rc, r0[i])
+            td = 2.0 * renv / C
+            n_lo = np.maximum(0, np.ceil((td - 0.5 * plen - ws) * fs)).astype(np.int64)
+            n_hi = np.minimum(n_s - 1, np.floor((td + 0.5 * plen - ws) * fs)).astype(np.int64)
+            if np.all(n_hi < n_lo):
+                continue
+            n = np.arange(n_lo.min(), n_hi.max() + 1)  # the band of samples this target touches
+            tau = ws + n[None, :] / fs - td[:, None]
+            inside = (n[None, :] >= n_lo[:, None]) & (n[None, :] <= n_hi[:, None])
+            sig = (amp[i] * g * np.exp(-4j * np.pi * rc / lam))[:, None] * np.exp(1j * np.pi * kr * tau**2)
+            out[c, ks[:, None], n[None, :]] += np.where(inside, sig, 0)
