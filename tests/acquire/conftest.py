@@ -49,6 +49,7 @@ points = 201
 if_bandwidth_hz = 1000
 data_format = "FORM2"
 read_timeout_ms = 40
+opc_read_timeout_ms = 100
 data_timeout_s = 0.3
 retries = 3
 

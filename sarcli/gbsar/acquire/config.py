@@ -41,6 +41,7 @@ class VnaConfig:
     max_frequency_hz: float = vna.MAX_FREQUENCY_OPT006_HZ  # 3e9 without option 006
     read_timeout_ms: int = 500      # Prologix ++read_tmo_ms
     data_timeout_s: float = 5.0     # extra time allowed for a whole data block
+    opc_read_timeout_ms: int = 3000  # ++read_tmo_ms while waiting for OPC? after SING (<= 3000)
     retries: int = 3
     preset: bool = True
 
@@ -173,8 +174,8 @@ def validate(cfg: ScanConfig, max_frequency_hz: float | None = None, max_travel_
         raise ConfigError(f"data_format '{v.data_format}' must be one of {', '.join(vna.DATA_FORMATS)}")
     if not 0 <= v.gpib_address <= 30 or not 0 <= p.address <= 30:
         raise ConfigError("GPIB addresses must be 0..30")
-    if not 1 <= v.read_timeout_ms <= 3000:
-        raise ConfigError("vna.read_timeout_ms must be 1..3000 (Prologix limit)")
+    if not (1 <= v.read_timeout_ms <= 3000 and 1 <= v.opc_read_timeout_ms <= 3000):
+        raise ConfigError("vna.read_timeout_ms and opc_read_timeout_ms must be 1..3000 (Prologix limit)")
     if v.retries < 0 or r.retries < 0:
         raise ConfigError("retries must be >= 0")
     pols = p.polarizations

@@ -52,7 +52,8 @@ def connect(cfg: ScanConfig, vna_port: str, rail_port: str,
         ports.append(rp)
         gpib = Prologix(vp, cfg.vna.gpib_address, cfg.vna.read_timeout_ms, cfg.vna.retries)
         ident: dict[str, Any] = {"prologix_version": gpib.init()}
-        vna = Prologix8753(gpib, cfg.vna.gpib_address, cfg.vna.retries, cfg.vna.data_timeout_s)
+        vna = Prologix8753(gpib, cfg.vna.gpib_address, cfg.vna.retries, cfg.vna.data_timeout_s,
+                           cfg.vna.opc_read_timeout_ms)
         vid = vna.identify()
         if vid["model"].upper() != cfg.vna.model.upper():
             raise InstrumentError(f"the VNA at {vna_port} identifies as '{vid['idn']}', "

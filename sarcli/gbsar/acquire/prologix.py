@@ -115,6 +115,13 @@ class Prologix:
                 f"'{self.version[:60]}'")
         return self.version
 
+    def set_read_timeout(self, ms: int) -> None:
+        """Change ``++read_tmo_ms`` (1..3000) if it differs from the current value."""
+        ms = int(min(max(ms, 1), 3000))
+        if ms != self.read_tmo_ms:
+            self.adapter(f"read_tmo_ms {ms}")
+            self.read_tmo_ms = ms
+
     def select(self, address: int, force: bool = False) -> None:
         """Address another GPIB device (``++addr``) if it is not the current one."""
         if force or address != self.address:

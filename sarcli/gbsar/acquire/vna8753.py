@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarcli.gbsar.acquire.errors import GarbledData, InstrumentError, InstrumentTimeout
-from sarcli.gbsar.acquire.prologix import Prologix
+from sarcli.gbsar.acquire.prologix import READ_MARGIN_S, Prologix
 
 ALLOWED_POINTS = (3, 11, 26, 51, 101, 201, 401, 801, 1601)
 ALLOWED_IFBW_HZ = (10, 30, 100, 300, 1000, 3000, 3700, 6000)
@@ -62,9 +62,13 @@ class VnaSettings:
 class Prologix8753:
     """The analyzer at GPIB ``address`` behind ``gpib``."""
 
-    def __init__(self, gpib: Prologix, address: int = 16, retries: int = 3, data_timeout_s: float = 5.0):
+    def __init__(self, gpib: Prologix, address: int = 16, retries: int = 3, data_timeout_s: float = 5.0,
+                 opc_read_tmo_ms: int = 3000):
         self.gpib, self.address, self.retries = gpib, int(address), int(retries)
         self.data_timeout_s = float(data_timeout_s)
+        self.opc_read_tmo_ms = int(opc_read_tmo_ms)
+        # sweep deadline: 1.5 x SWET + 4 OPC polls
+        self.sweep_margin_s = 4 * (opc_read_tmo_ms / 1000.0 + READ_MARGIN_S)
         self.settings: VnaSettings | None = None
         self.sweep_time_s = 0.0
         self.retry_count = 0  # recoveries so far (reported in the scan file)
@@ -135,18 +139,28 @@ class Prologix8753:
         return out
 
     def wait_opc(self, command: str, timeout_s: float) -> None:
-        """``OPC?;<command>`` and poll ``++read eoi`` until ``1`` arrives (or the deadline)."""
+        """``OPC?;<command>`` and poll ``++read eoi`` until ``1`` arrives (or the deadline).
+
+        The adapter's read timeout is raised to ``opc_read_tmo_ms`` (<= 3000) meanwhile, so that the
+        ``1`` is passed on as soon as the sweep ends instead of after a host-side poll period.
+        """
+        normal = self.gpib.read_tmo_ms
         self.gpib.port.discard_input()
         self.send(f"OPC?;{command}")
-        deadline = time.monotonic() + timeout_s
+        self.gpib.set_read_timeout(self.opc_read_tmo_ms)
+        try:
+            self._poll_opc(command, time.monotonic() + timeout_s)
+        finally:
+            self.gpib.set_read_timeout(normal)
+
+    def _poll_opc(self, command: str, deadline: float) -> None:
         while True:
             self.gpib.request_read()
             try:
                 line = self.gpib.port.read_until(b"\n", time.monotonic() + self.gpib.read_window_s)
             except InstrumentTimeout:
                 if time.monotonic() > deadline:
-                    raise InstrumentTimeout(
-                        f"VNA: {command} not complete after {timeout_s:.1f} s (OPC? never answered)") from None
+                    raise InstrumentTimeout(f"VNA: {command} not complete in time (OPC? never answered)") from None
                 continue
             if line.strip() == b"1":
                 return
@@ -179,7 +193,7 @@ class Prologix8753:
     # -- measurement -----------------------------------------------------------------------------
     def sweep(self) -> None:
         """One single sweep, returning when it is complete."""
-        self.wait_opc("SING", timeout_s=1.5 * self.sweep_time_s + 4 * self.gpib.read_window_s + 2.0)
+        self.wait_opc("SING", timeout_s=1.5 * self.sweep_time_s + self.sweep_margin_s)
 
     def read_data(self) -> np.ndarray:
         """The last sweep's error-corrected data (``OUTPDATA``) as complex128 (points,)."""
