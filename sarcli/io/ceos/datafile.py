@@ -146,13 +146,7 @@ def index_records(buf: np.ndarray, src: str) -> RecordIndex:
 
 def build_descriptor(n_records: int, max_length: int, n_samples: int, software_id: str) -> bytes:
     """The 16252-byte imagery-options file descriptor of a RAW data file."""
-    d = F.blank_record(1, F.CODES_FILE_DESCRIPTOR, DESCRIPTOR_BYTES)
-    F.put(d, 13, b"A ")
-    F.put(d, 17, F.format_text("CEOS-SAR-CCT", 12))
-    F.put(d, 33, F.format_text(software_id, 12))
-    F.put(d, 45, F.format_int(2, 4))
-    F.put(d, 49, F.format_text("DAT_01.001", 16))
-    F.put(d, 65, F.format_text("FSEQ", 4))
+    d = F.file_descriptor(DESCRIPTOR_BYTES, 2, "DAT_01.001", software_id)
     F.put(d, 181, F.format_int(n_records, 6) + F.format_int(max_length, 6))
     F.put(d, 217, F.format_int(8, 4) + F.format_int(2, 4) + F.format_int(2, 4))
     F.put(d, 237, F.format_int(n_records, 8) + F.format_int(0, 4) + F.format_int(n_samples, 8))

@@ -66,24 +66,25 @@ def _where(name: str, first: int, last: int, source: str) -> str:
     return f"{source}: field '{name}' (bytes {first}-{last})"
 
 
-def parse_int(rec: bytes | memoryview, first: int, last: int, name: str, source: str = "CEOS") -> int | None:
-    """Decode an ``In`` field; blank -> ``None``; garbage -> :class:`FormatError`."""
+def _parse_number(rec, first: int, last: int, name: str, source: str, pattern: re.Pattern, what: str,
+                  convert):
     s = ascii_field(rec, first, last)
     if not s:
         return None
-    if not _INTEGER.match(s):
-        raise FormatError(f"{_where(name, first, last, source)} holds {s!r}, not an integer")
-    return int(s)
+    if not pattern.match(s):
+        raise FormatError(f"{_where(name, first, last, source)} holds {s!r}, not {what}")
+    return convert(s)
+
+
+def parse_int(rec: bytes | memoryview, first: int, last: int, name: str, source: str = "CEOS") -> int | None:
+    """Decode an ``In`` field; blank -> ``None``; garbage -> :class:`FormatError`."""
+    return _parse_number(rec, first, last, name, source, _INTEGER, "an integer", int)
 
 
 def parse_real(rec: bytes | memoryview, first: int, last: int, name: str, source: str = "CEOS") -> float | None:
     """Decode an ``F``/``E``/``D`` field (Fortran ``D`` exponents accepted); blank -> ``None``."""
-    s = ascii_field(rec, first, last)
-    if not s:
-        return None
-    if not _NUMBER.match(s):
-        raise FormatError(f"{_where(name, first, last, source)} holds {s!r}, not a number")
-    return float(s.replace("D", "E").replace("d", "e"))
+    return _parse_number(rec, first, last, name, source, _NUMBER, "a number",
+                         lambda s: float(s.replace("D", "E").replace("d", "e")))
 
 
 def require_value(value: float | int | None, name: str, first: int, last: int, source: str = "CEOS"):
@@ -129,4 +130,15 @@ def blank_record(sequence: int, codes: tuple[int, int, int, int], length: int) -
     """A record of ``length`` bytes: its header, then blanks (the CEOS 'missing' value for ASCII)."""
     rec = bytearray(b" " * length)
     rec[:HEADER_BYTES] = pack_header(sequence, codes, length)
+    return rec
+
+
+def file_descriptor(length: int, file_number: int, file_name: str, software_id: str) -> bytearray:
+    """The common head of a file descriptor record (record 1 of every CEOS file): ASCII flag,
+    ``CEOS-SAR-CCT``, software id, file number (45-48), file name (49-64), ``FSEQ`` (65-68)."""
+    rec = blank_record(1, CODES_FILE_DESCRIPTOR, length)
+    put(rec, 13, b"A ")
+    put(rec, 17, format_text("CEOS-SAR-CCT", 12))
+    put(rec, 33, format_text(software_id, 12))
+    put(rec, 45, format_int(file_number, 4) + format_text(file_name, 16) + format_text("FSEQ", 4))
     return rec

@@ -145,13 +145,7 @@ def parse_leader(buf: bytes, src: str) -> LeaderInfo:
 
 def build_leader(info: LeaderInfo, software_id: str) -> bytes:
     """The three leader records (file descriptor, data set summary, platform position) as bytes."""
-    fd = F.blank_record(1, F.CODES_FILE_DESCRIPTOR, FILE_DESCRIPTOR_BYTES)
-    F.put(fd, 13, b"A ")
-    F.put(fd, 17, F.format_text("CEOS-SAR-CCT", 12))
-    F.put(fd, 33, F.format_text(software_id, 12))
-    F.put(fd, 49, F.format_int(1, 8))
-    F.put(fd, 57, F.format_text("LEA_01.001", 16))
-    F.put(fd, 73, F.format_text("FSEQ", 4))
+    fd = F.file_descriptor(FILE_DESCRIPTOR_BYTES, 1, "LEA_01.001", software_id)
     F.put(fd, 181, F.format_int(1, 6) + F.format_int(DSS_BYTES, 6) + F.format_int(0, 6) * 2)
     F.put(fd, 205, F.format_int(1, 6) + F.format_int(PLATFORM_BYTES, 6))
     for first in range(217, 361, 12):  # attitude .. remaining record pairs: none in RAW

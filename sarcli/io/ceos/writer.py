@@ -263,9 +263,6 @@ def write_ceos(out_dir: str | os.PathLike, raw: RawProduct) -> tuple[Path, Path]
     folder.mkdir(exist_ok=True)
     lea = _atomic_write(folder, "LEA_01.001", [build_leader(info, SOFTWARE_ID)])
     dat = _atomic_write(folder, "DAT_01.001", _data_records(raw, times_us, year, doy, codes, rep))
-    trailer = F.blank_record(1, F.CODES_FILE_DESCRIPTOR, 720)
-    F.put(trailer, 13, b"A ")
-    F.put(trailer, 17, F.format_text("CEOS-SAR-CCT", 12))
-    _atomic_write(folder, "TRA_01.001", [bytes(trailer)])
+    _atomic_write(folder, "TRA_01.001", [bytes(F.file_descriptor(720, 3, "TRA_01.001", SOFTWARE_ID))])
     _atomic_write(folder, "VDF_DAT.001", [_volume(n)])
     return lea, dat
