@@ -1,0 +1,305 @@
+"""Range-Doppler algorithm (RDA), processed in azimuth blocks with overlap (bounded memory).
+
+Per block of output lines [s, e) the raw lines [s - P, e + P) are read (zeros beyond the scene), with
+P = ceil(aperture/2 + residual shift) lines so that every output line sees its whole processed
+aperture, and processed as
+
+1. AGC undone (x 10**(agc_db/20) per line), range FFT (linear convolution length), matched filter
+   (:mod:`sarcli.focus.rangecomp`), range IFFT -> range-compressed lines on the raw range grid;
+2. azimuth FFT (block length N >= e - s + 2P);
+3. optional SRC at the mid-swath range (range FFT with a 64-sample guard, 2-D multiply, range IFFT);
+4. RCMC + azimuth matched filter with the range-dependent centroid and rate of that block
+   (:mod:`sarcli.focus.rcmc`), evaluated from the Doppler model at the block's centre time;
+5. azimuth IFFT; lines [P, P + e - s) of the block are output lines [s, e).
+
+Output geometry: column i is closest-approach slant range ``r_first + i dr`` (the raw range grid); line
+j has ZERO-DOPPLER time ``t_raw[j] - shift/PRF``, where ``shift`` (integer lines) is the beam-centre
+offset Delta = R0 tan(theta)/V at mid-swath and scene centre (:mod:`sarcli.focus.kinematics`):
+every target lands within a few lines of its raw data, so squinted scenes (centroids of several PRFs)
+need no more overlap than broadside ones. Lines closer than half an aperture to the scene ends see
+only part of their aperture (``first_full_line`` / ``last_full_line``; a warning when none is whole).
+Peak extra memory per block: about N x n_samples x 8 B x 2 (complex64) plus the range FFT of the lines.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import scipy.fft as sfft
+
+from sarcli.errors import SarcliError
+from sarcli.focus.interp import table_for
+from sarcli.focus.kinematics import aperture_time, beam_centre_offset, velocity_and_squint
+from sarcli.focus.rangecomp import (
+    C,
+    apply_range_filter_2d,
+    compress_lines,
+    inverse_src_rate,
+    range_filter,
+    reference_pulse,
+)
+from sarcli.focus.rcmc import rcmc_azimuth
+from sarcli.focus.windows import parse_window, window_table
+from sarcli.io.raw import RawProduct
+from sarcli.io.slc import SLC, DopplerUsed
+
+SRC_GUARD = 64
+
+
+@dataclass(frozen=True)
+class RdKnobs:
+    """Processing knobs of the RDA (each one's accuracy/cost is measured in bench/bench_focus.py).
+
+    range_window, azimuth_window: window specs (:mod:`sarcli.focus.windows`); range_bandwidth_fraction:
+    processed part of the chirp band (1 = all of it); azimuth_bandwidth_hz:
+    processed Doppler band (default 0.8 PRF); rcmc: interpolator (nearest, linear, sinc4/8/16);
+    src: secondary range compression; precision: "single" (complex64) or "double" (complex128);
+    block_lines: azimuth FFT length per block; use_replica: the product's replica, else the nominal chirp.
+    """
+
+    range_window: str = "kaiser:2.5"
+    range_bandwidth_fraction: float = 1.0
+    azimuth_window: str = "kaiser:2.5"
+    azimuth_bandwidth_hz: float | None = None
+    rcmc: str = "sinc8"
+    src: bool = True
+    precision: str = "single"
+    block_lines: int = 4096
+    use_replica: bool = True
+    workers: int = -1
+
+
+def make_knobs(**kw) -> RdKnobs:
+    """RdKnobs from keyword arguments, refusing unknown names and bad values in one line."""
+    names = set(RdKnobs.__dataclass_fields__)
+    bad = sorted(set(kw) - names)
+    if bad:
+        raise SarcliError(f"unknown focus option(s) {', '.join(bad)}; known: {', '.join(sorted(names))}")
+    k = RdKnobs(**{n: v for n, v in kw.items() if v is not None or n == "azimuth_bandwidth_hz"})
+    parse_window(k.range_window)
+    parse_window(k.azimuth_window)
+    table_for(k.rcmc)
+    if k.precision not in ("single", "double"):
+        raise SarcliError(f"precision must be 'single' or 'double', got {k.precision!r}")
+    if k.block_lines < 64:
+        raise SarcliError(f"block_lines must be at least 64, got {k.block_lines}")
+    return k
+
+
+def _uniform_prf(t: np.ndarray, radar_prf: float) -> float:
+    if t.size < 2:
+        return radar_prf
+    dt = np.diff(t)
+    med = float(np.median(dt))
+    if np.max(np.abs(dt - med)) > 1e-3 * med:
+        raise SarcliError("azimuth lines are not uniformly spaced (PRF change or gap): the RD focuser needs a"
+                          " uniform PRF; split the scene at the gap")
+    return 1.0 / med
+
+
+def doppler_on_grid(doppler, r0: np.ndarray, t: float, wavelength: float):
+    """(fdc, fr, V, sin_squint) per closest range r0 at raw time t.
+
+    The model is indexed by beam-centre range R_c = R0 / cos(theta): evaluated at R0 first, then at
+    the R_c that this gives (one refinement; fdc and fr vary slowly with range). Refuses NaN/inf.
+    """
+    tt = np.full_like(r0, t)
+    fdc = np.asarray(doppler.fdc(r0, tt), np.float64)
+    fr = np.asarray(doppler.fr(r0, tt), np.float64)
+    v, s = velocity_and_squint(fdc, fr, r0, wavelength)
+    rc = r0 / np.sqrt(1.0 - s * s)
+    fdc = np.broadcast_to(np.asarray(doppler.fdc(rc, tt), np.float64), r0.shape).copy()
+    fr = np.broadcast_to(np.asarray(doppler.fr(rc, tt), np.float64), r0.shape).copy()
+    v, s = velocity_and_squint(fdc, fr, r0, wavelength)
+    return fdc, fr, v, s
+
+
+def _coverage_warnings(doppler, r: np.ndarray, t: np.ndarray) -> list[str]:
+    """Warn when the scene lies outside the range/time span the Doppler model was estimated on."""
+    blocks = getattr(doppler, "blocks", None)
+    out = []
+    if isinstance(blocks, dict) and "range_m" in blocks and "azimuth_time_s" in blocks:
+        br, bt = np.asarray(blocks["range_m"], float), np.asarray(blocks["azimuth_time_s"], float)
+        if br.size and (r[0] < br.min() - 0.5 * np.ptp(r) or r[-1] > br.max() + 0.5 * np.ptp(r)):
+            out.append(f"Doppler table covers ranges {br.min():.0f}-{br.max():.0f} m, scene {r[0]:.0f}-{r[-1]:.0f} m:"
+                       " extrapolating")
+        span = max(np.ptp(t), 1e-9)
+        if bt.size and (t[0] < bt.min() - 0.5 * span or t[-1] > bt.max() + 0.5 * span):
+            out.append(f"Doppler table covers times {bt.min():.3f}-{bt.max():.3f} s, scene {t[0]:.3f}-{t[-1]:.3f} s:"
+                       " extrapolating")
+    return out
+
+
+@dataclass
+class _Plan:
+    prf: float
+    ranges: np.ndarray
+    wavelength: float
+    ba: float
+    shift: int
+    pad: int
+    n_fft_az: int
+    n_valid: int
+    n_fft_r: int
+    full_aperture: float
+
+
+def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan:
+    radar = raw.radar
+    n_lines = shape[0]
+    prf = _uniform_prf(raw.azimuth_time, radar.prf_hz)
+    ranges = radar.first_range_m + np.arange(shape[1]) * C / (2.0 * radar.range_sampling_rate_hz)
+    lam = C / radar.carrier_frequency_hz
+    ba = 0.8 * prf if k.azimuth_bandwidth_hz is None else float(k.azimuth_bandwidth_hz)
+    if not 0.0 < ba <= prf:
+        raise SarcliError(f"azimuth bandwidth {ba:.4g} Hz must be in (0, PRF = {prf:.4g} Hz]")
+    t = raw.azimuth_time
+    offsets, fr_abs = [], []
+    for tb in (t[0], 0.5 * (t[0] + t[-1]), t[-1]):
+        _, fr, v, s = doppler_on_grid(doppler, ranges, float(tb), lam)
+        offsets.append(beam_centre_offset(ranges, v, s) * prf)
+        fr_abs.append(np.abs(fr))
+    mid = len(ranges) // 2
+    shift = int(round(float(offsets[1][mid])))
+    resid = max(float(np.max(np.abs(o - shift))) for o in offsets)
+    aperture = float(np.max(aperture_time(np.min(fr_abs, axis=0), ba))) * prf
+    pad = int(math.ceil(0.5 * aperture + resid)) + 4
+    n_fft_az = sfft.next_fast_len(max(k.block_lines, 4 * pad) if n_lines + 2 * pad > k.block_lines
+                                  else n_lines + 2 * pad)
+    n_valid = min(n_lines, n_fft_az - 2 * pad)
+    n_ref = reference_pulse(radar, raw.replica if k.use_replica else None).size
+    n_fft_r = sfft.next_fast_len(len(ranges) + n_ref - 1)
+    return _Plan(prf, ranges, lam, ba, shift, pad, n_fft_az, n_valid, n_fft_r, aperture)
+
+
+def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
+                 sink: Callable[[int, np.ndarray], None], doppler, knobs: RdKnobs,
+                 shape: tuple[int, int], on_block: Callable[[int, int], None] | None = None) -> SLC:
+    """Focus lines read by ``read_lines(a, b)`` and hand output blocks to ``sink(first_line, block)``.
+
+    ``raw`` supplies metadata (its echo may be empty), ``shape`` = (n_lines, n_samples) of the echo;
+    returns the SLC metadata with an empty image.
+    """
+    k = knobs
+    t_start = time.perf_counter()
+    timings = {"range_compression_s": 0.0, "azimuth_fft_s": 0.0, "src_s": 0.0, "rcmc_azimuth_s": 0.0,
+               "azimuth_ifft_s": 0.0, "io_s": 0.0}
+    radar = raw.radar
+    n_lines = shape[0]
+    if n_lines < 2:
+        raise SarcliError("the scene has fewer than two azimuth lines: nothing to focus")
+    p = _plan(raw, shape, doppler, k)
+    nr = p.ranges.size
+    cdt = np.complex64 if k.precision == "single" else np.complex128
+    h, _ = range_filter(radar, p.n_fft_r, k.range_window, raw.replica if k.use_replica else None,
+                        k.range_bandwidth_fraction)
+    h = h.astype(cdt)
+    wtab = window_table(k.azimuth_window)
+    kind, table = table_for(k.rcmc)
+    f_bin = sfft.fftfreq(p.n_fft_az, 1.0 / p.prf)
+    dr = C / (2.0 * radar.range_sampling_rate_hz)
+    gain = None if raw.agc_db is None else (10.0 ** (np.asarray(raw.agc_db, np.float64) / 20.0)).astype(np.float32)
+    t_raw = raw.azimuth_time
+    dt = 1.0 / p.prf
+    msgs = _coverage_warnings(doppler, p.ranges, t_raw)
+    first_full = int(math.ceil(0.5 * p.full_aperture))
+    last_full = n_lines - 1 - first_full
+    if first_full > last_full:
+        msgs.append(f"scene ({n_lines} lines) is shorter than the synthetic aperture ({p.full_aperture:.0f} lines):"
+                    " no line is fully focused")
+    for m in msgs:
+        warnings.warn(m, stacklevel=2)
+    r_mid = float(p.ranges[nr // 2])
+    block_times, fdcs, frs, vs = [], [], [], []
+    n_blocks = int(math.ceil(n_lines / p.n_valid))
+    for b in range(n_blocks):
+        s = b * p.n_valid
+        e = min(s + p.n_valid, n_lines)
+        a, z = max(0, s - p.pad), min(n_lines, e + p.pad)
+        t0 = time.perf_counter()
+        data = np.asarray(read_lines(a, z))
+        timings["io_s"] += time.perf_counter() - t0
+        if data.shape != (z - a, nr):
+            raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
+        t0 = time.perf_counter()
+        x = compress_lines(data if gain is None else data * gain[a:z, None], h, nr, k.workers)
+        y = np.zeros((p.n_fft_az, nr), cdt)
+        off = a - (s - p.pad)
+        y[off:off + (z - a)] = x
+        del x, data
+        timings["range_compression_s"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        y = sfft.fft(y, axis=0, overwrite_x=True, workers=k.workers)
+        timings["azimuth_fft_s"] += time.perf_counter() - t0
+        tb = float(t_raw[0] + 0.5 * (s + e - 1) * dt)
+        fdc, fr, v, _ = doppler_on_grid(doppler, p.ranges, tb, p.wavelength)
+        block_times.append(tb)
+        fdcs.append(fdc)
+        frs.append(fr)
+        vs.append(v)
+        if k.src:
+            t0 = time.perf_counter()
+            n2 = sfft.next_fast_len(nr + SRC_GUARD)
+            zz = sfft.fft(y, n=n2, axis=1, workers=k.workers)
+            off_f = f_bin - fdc[nr // 2]
+            f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
+            inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
+            apply_range_filter_2d(zz, np.ones(n2, cdt), sfft.fftfreq(n2, 1.0 / radar.range_sampling_rate_hz),
+                                  inv_k)
+            zz = sfft.ifft(zz, axis=1, overwrite_x=True, workers=k.workers)
+            y[...] = zz[:, :nr]
+            del zz
+            timings["src_s"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        rcmc_azimuth(y, f_bin, float(p.ranges[0]), dr, p.ranges, v, fdc, p.wavelength, p.prf, p.ba, wtab, kind,
+                     table, p.shift, y)
+        timings["rcmc_azimuth_s"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        y = sfft.ifft(y, axis=0, overwrite_x=True, workers=k.workers)
+        timings["azimuth_ifft_s"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        sink(s, y[p.pad:p.pad + (e - s)].astype(np.complex64, copy=False))
+        timings["io_s"] += time.perf_counter() - t0
+        if on_block is not None:
+            on_block(b + 1, n_blocks)
+    timings["total_s"] = time.perf_counter() - t_start
+    v_mid = float(np.median(np.asarray(vs)[:, nr // 2]))
+    params = {"algorithm": "rd", **asdict(k), "azimuth_bandwidth_hz": p.ba, "prf_hz": p.prf,
+              "shift_lines": p.shift, "overlap_lines": p.pad, "azimuth_fft_length": p.n_fft_az,
+              "range_fft_length": p.n_fft_r, "n_blocks": n_blocks, "aperture_lines": p.full_aperture,
+              "replica_used": bool(k.use_replica and raw.replica is not None and np.size(raw.replica) > 1),
+              "warnings": msgs}
+    return SLC(
+        image=np.zeros((0, 0), np.complex64),
+        azimuth_time=t_raw[0] + (np.arange(n_lines) - p.shift) * dt,
+        slant_range=p.ranges.copy(), epoch_utc=raw.epoch_utc, radar=radar,
+        doppler=DopplerUsed(np.asarray(block_times), p.ranges.copy(), np.asarray(fdcs), np.asarray(frs),
+                            np.asarray(vs)),
+        look_side=raw.look_side, source=raw.source, algorithm="rd",
+        azimuth_spacing_m=v_mid / p.prf, first_full_line=first_full, last_full_line=last_full,
+        parameters=params, timings=timings, orbit=raw.orbit, attitude=raw.attitude, truth=raw.truth,
+    )
+
+
+def focus_rd(raw: RawProduct, doppler, channel: int = 0, **knobs) -> SLC:
+    """Focus one receive channel of an in-memory raw product with the RDA (contract 5).
+
+    ``doppler``: any object with vectorized ``fdc(range_m, t)`` and ``fr(range_m, t)``. Knobs: see
+    :class:`RdKnobs`. Returns an :class:`sarcli.io.slc.SLC` with zero-Doppler times and slant ranges.
+    """
+    k = make_knobs(**knobs)
+    echo = raw.channel(channel)
+    n_lines, nr = echo.shape
+    out = np.zeros((n_lines, nr), np.complex64)
+
+    def sink(s: int, block: np.ndarray) -> None:
+        out[s:s + block.shape[0]] = block
+
+    slc = focus_stream(raw, lambda a, b: echo[a:b], sink, doppler, k, (n_lines, nr))
+    slc.image = out
+    return slc

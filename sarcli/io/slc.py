@@ -1,0 +1,219 @@
+"""The single-look complex image product (``product_type = "slc"``), schema version 1.
+
+Layout (SI units)::
+
+    /                      provenance attributes (sarcli.io.h5common), epoch_utc, look_side, source,
+                           algorithm, azimuth_spacing_m, range_spacing_m, prf_hz,
+                           first_full_line / last_full_line (lines with the whole processed aperture)
+    /image                 complex64 (n_lines, n_samples), chunked; azimuth along axis 0. Phase
+                           convention: a scatterer at closest range R0 has phase arg(sigma) - 4 pi R0/lam
+                           at its peak; the azimuth spectrum is centred on the Doppler centroid.
+    /azimuth_time          float64 (n_lines,) ZERO-DOPPLER time of each line, s after epoch_utc
+    /slant_range           float64 (n_samples,) closest-approach slant range of each column, m
+    /doppler               the Doppler actually used, per processing block: block_time (n_blocks,) s
+                           (raw time at which the model was evaluated), range_m (n_samples,),
+                           fdc_hz, fr_hz_per_s, velocity_mps (n_blocks, n_samples)
+    /radar                 the raw product's radar attributes
+    /orbit, /attitude      copied from the raw product when present (geolocation)
+    /truth                 copied from a simulated raw product (``sarcli quality`` compares with it)
+    /timings               attributes: seconds per processing stage
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import h5py
+import numpy as np
+
+from sarcli.errors import ProductError
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.raw import Attitude, Orbit, Radar
+
+PRODUCT_TYPE = "slc"
+SCHEMA_VERSION = "1"
+
+
+@dataclass
+class DopplerUsed:
+    """Centroid, rate and effective velocity used per processing block (rows) and range (columns)."""
+
+    block_time: np.ndarray
+    range_m: np.ndarray
+    fdc_hz: np.ndarray
+    fr_hz_per_s: np.ndarray
+    velocity_mps: np.ndarray
+
+
+@dataclass
+class SLC:
+    """In-memory focused image with its axes; ``image`` (n_lines, n_samples) complex64."""
+
+    image: np.ndarray
+    azimuth_time: np.ndarray
+    slant_range: np.ndarray
+    epoch_utc: str
+    radar: Radar
+    doppler: DopplerUsed
+    look_side: str = "right"
+    source: str = "simulated"
+    algorithm: str = "rd"
+    azimuth_spacing_m: float = float("nan")
+    first_full_line: int = 0
+    last_full_line: int = -1
+    parameters: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+    orbit: Orbit | None = None
+    attitude: Attitude | None = None
+    truth: dict[str, Any] | None = None
+
+    @property
+    def prf_hz(self) -> float:
+        return float(1.0 / np.median(np.diff(self.azimuth_time))) if self.azimuth_time.size > 1 else self.radar.prf_hz
+
+    @property
+    def range_spacing_m(self) -> float:
+        return float(self.slant_range[1] - self.slant_range[0]) if self.slant_range.size > 1 else float("nan")
+
+
+def _write_meta(f: h5py.File, s: SLC) -> None:
+    f.attrs["epoch_utc"] = s.epoch_utc
+    f.attrs["look_side"] = s.look_side
+    f.attrs["source"] = s.source
+    f.attrs["algorithm"] = s.algorithm
+    f.attrs["azimuth_spacing_m"] = float(s.azimuth_spacing_m)
+    f.attrs["range_spacing_m"] = s.range_spacing_m
+    f.attrs["prf_hz"] = s.prf_hz
+    f.attrs["first_full_line"] = int(s.first_full_line)
+    f.attrs["last_full_line"] = int(s.last_full_line)
+    dataset(f, "azimuth_time", np.asarray(s.azimuth_time, np.float64), units="s",
+            description="zero-Doppler time after epoch_utc")
+    dataset(f, "slant_range", np.asarray(s.slant_range, np.float64), units="m",
+            description="closest-approach slant range")
+    g = group(f, "doppler")
+    d = s.doppler
+    dataset(g, "block_time", np.asarray(d.block_time, np.float64), units="s")
+    dataset(g, "range_m", np.asarray(d.range_m, np.float64), units="m")
+    dataset(g, "fdc_hz", np.asarray(d.fdc_hz, np.float64), units="Hz")
+    dataset(g, "fr_hz_per_s", np.asarray(d.fr_hz_per_s, np.float64), units="Hz/s")
+    dataset(g, "velocity_mps", np.asarray(d.velocity_mps, np.float64), units="m/s")
+    rg = group(f, "radar")
+    for fld in dataclasses.fields(Radar):
+        v = getattr(s.radar, fld.name)
+        if v is not None:
+            rg.attrs[fld.name] = np.asarray(v, np.float64) if fld.name == "receiver_offsets_m" else v
+    if s.orbit is not None:
+        og = group(f, "orbit")
+        og.attrs["frame"] = s.orbit.frame
+        dataset(og, "time", np.asarray(s.orbit.time, np.float64), units="s")
+        dataset(og, "position", np.asarray(s.orbit.position, np.float64), units="m")
+        dataset(og, "velocity", np.asarray(s.orbit.velocity, np.float64), units="m/s")
+    if s.attitude is not None:
+        ag = group(f, "attitude")
+        dataset(ag, "time", np.asarray(s.attitude.time, np.float64), units="s")
+        for name in ("pitch", "roll", "yaw"):
+            dataset(ag, name, np.asarray(getattr(s.attitude, name), np.float64), units="rad")
+    if s.truth is not None:
+        tg = group(f, "truth")
+        for k in sorted(s.truth):
+            v = s.truth[k]
+            if isinstance(v, str):
+                tg.attrs[k] = v
+            elif v is not None:
+                dataset(tg, k, np.asarray(v))
+    tg = group(f, "timings")
+    for k, v in sorted(s.timings.items()):
+        tg.attrs[k] = float(v)
+
+
+@contextlib.contextmanager
+def slc_writer(path: str | os.PathLike, meta: SLC, shape: tuple[int, int], inputs: tuple = (),
+               compression: str | None = None) -> Iterator[h5py.Dataset]:
+    """Create the product atomically and yield the empty ``/image`` dataset to fill block by block.
+
+    ``meta`` carries everything but the image (its ``image`` may be empty); metadata that is only
+    known after processing (timings, Doppler) can be updated on ``meta`` inside the block: it is
+    written when the block exits.
+    """
+    chunks = (min(shape[0], 256), min(shape[1], 2048))
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, meta.parameters, inputs) as f:
+        ds = f.create_dataset("image", shape=shape, dtype=np.complex64, chunks=chunks, track_times=False,
+                              **({"compression": compression} if compression else {}))
+        ds.attrs["units"] = "1"
+        ds.attrs["description"] = "focused single-look complex image (zero-Doppler line, slant-range column)"
+        yield ds
+        _write_meta(f, meta)
+
+
+def write_slc(path: str | os.PathLike, s: SLC, inputs: tuple = ()) -> None:
+    """Write an in-memory SLC atomically."""
+    if s.image.shape != (s.azimuth_time.size, s.slant_range.size):
+        raise ProductError(f"SLC image shape {s.image.shape} does not match its axes")
+    with slc_writer(path, s, s.image.shape, inputs) as ds:
+        ds[...] = np.asarray(s.image, np.complex64)
+
+
+def read_slc(path: str | os.PathLike, load_image: bool = True) -> SLC:
+    """Read an SLC product; a malformed file raises :class:`ProductError` (one line)."""
+    with open_product(path, PRODUCT_TYPE) as f:
+        sv = attr_str(f, "schema_version")
+        if sv != SCHEMA_VERSION:
+            raise ProductError(f"{path}: slc schema version {sv} is not supported (expected {SCHEMA_VERSION})")
+        img = require(f, "image", path, shape_rank=2, dtype_kind="c")
+        t = require(f, "azimuth_time", path, shape_rank=1, dtype_kind="f")[()]
+        r = require(f, "slant_range", path, shape_rank=1, dtype_kind="f")[()]
+        if img.shape != (t.size, r.size):
+            raise ProductError(f"{path}: malformed product, image {img.shape} vs axes ({t.size}, {r.size})")
+        if "radar" not in f or "doppler" not in f:
+            raise ProductError(f"{path}: malformed product, missing 'radar' or 'doppler'")
+        g = f["radar"]
+        kw: dict[str, Any] = {}
+        for fld in dataclasses.fields(Radar):
+            if fld.name in g.attrs:
+                v = g.attrs[fld.name]
+                if fld.name == "receiver_offsets_m":
+                    v = tuple(float(x) for x in np.atleast_1d(v))
+                elif fld.name == "quantization_bits":
+                    v = int(v)
+                else:
+                    v = float(v)
+                kw[fld.name] = v
+        try:
+            radar = Radar(**kw)
+        except TypeError as e:
+            raise ProductError(f"{path}: malformed product, radar attributes incomplete ({e})") from None
+        dg = f["doppler"]
+        dop = DopplerUsed(*(require(dg, k, path)[()] for k in
+                            ("block_time", "range_m", "fdc_hz", "fr_hz_per_s", "velocity_mps")))
+        orbit = None
+        if "orbit" in f:
+            og = f["orbit"]
+            orbit = Orbit(og["time"][()], og["position"][()], og["velocity"][()], attr_str(og, "frame", "ECI"))
+        attitude = None
+        if "attitude" in f:
+            ag = f["attitude"]
+            attitude = Attitude(*(ag[k][()] for k in ("time", "pitch", "roll", "yaw")))
+        truth = None
+        if "truth" in f:
+            tg = f["truth"]
+            truth = {k: tg[k][()] for k in tg}
+            truth.update({k: attr_str(tg, k) for k in tg.attrs})
+        timings = dict(f["timings"].attrs) if "timings" in f else {}
+        params = json.loads(attr_str(f, "parameters") or "{}")
+        return SLC(
+            image=img[()] if load_image else np.zeros((t.size, 0), np.complex64),
+            azimuth_time=t, slant_range=r, epoch_utc=attr_str(f, "epoch_utc") or "", radar=radar,
+            doppler=dop, look_side=attr_str(f, "look_side", "right"), source=attr_str(f, "source", "unknown"),
+            algorithm=attr_str(f, "algorithm", "rd"),
+            azimuth_spacing_m=float(f.attrs.get("azimuth_spacing_m", np.nan)),
+            first_full_line=int(f.attrs.get("first_full_line", 0)),
+            last_full_line=int(f.attrs.get("last_full_line", t.size - 1)),
+            parameters=params, timings={k: float(v) for k, v in timings.items()},
+            orbit=orbit, attitude=attitude, truth=truth,
+        )
