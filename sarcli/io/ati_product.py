@@ -1,0 +1,89 @@
+"""The ATI moving-target product (``product_type = "ati"``), schema version 1.
+
+Layout (SI units)::
+
+    /                      provenance attributes (sarcli.io.h5common), epoch_utc, t_ref_s (reference time
+                           of every mover estimate, s after epoch_utc), frame ("LOCAL"), look_side,
+                           detection (JSON: CFAR knobs and summary), movers_json (JSON list, the
+                           ``sarcli ati estimate --json`` records)
+    /azimuth_time          float64 (n_lines,) zero-Doppler time of each image line, s after epoch_utc
+    /slant_range           float64 (n_samples,) closest-approach slant range of each column, m
+    /image_before          complex64 (n_lines, n_samples): channel-0 RD image (stationary-scene focusing)
+    /image_after           optional complex64: movers compensated and relocated (``sarcli ati compensate``)
+    /ati_phase             float32 (n_lines, n_samples): arg(Z1 * conj(Z0)) of the co-registered pair, rad
+    /movers                compound table, one row per mover: id, vx_mps, vy_mps, x0_m, y0_m, r0_m and their
+                           *_sigma (1-sigma), x_local_m, y_local_m (LOCAL frame at t_ref), confidence,
+                           ati_phase_rad, ati_ambiguous, vy_degenerate
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any
+
+import numpy as np
+
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, open_product, require, to_jsonable
+
+PRODUCT_TYPE = "ati"
+SCHEMA_VERSION = "1"
+MOVER_FIELDS = ("vx_mps", "vy_mps", "x0_m", "y0_m", "r0_m", "vx_mps_sigma", "vy_mps_sigma", "x0_m_sigma",
+                "y0_m_sigma", "r0_m_sigma", "x_local_m", "y_local_m", "confidence", "ati_phase_rad")
+
+
+def _table(movers: list[dict]) -> np.ndarray:
+    dt = [("id", "i4")] + [(k, "f8") for k in MOVER_FIELDS] + [("ati_ambiguous", "i1"), ("vy_degenerate", "i1")]
+    tab = np.zeros(len(movers), dt)
+    for i, m in enumerate(movers):
+        tab[i]["id"] = m.get("id", i)
+        for k in MOVER_FIELDS:
+            v = m.get(k)
+            tab[i][k] = np.nan if v is None else float(v)
+        tab[i]["ati_ambiguous"] = int(bool(m.get("ati_ambiguous", False)))
+        tab[i]["vy_degenerate"] = int(bool(m.get("vy_degenerate", False)))
+    return tab
+
+
+def write_ati(path: str | os.PathLike, *, epoch_utc: str, t_ref_s: float, look_side: str,
+              azimuth_time: np.ndarray, slant_range: np.ndarray, image_before: np.ndarray,
+              ati_phase: np.ndarray, movers: list[dict], detection: dict[str, Any],
+              image_after: np.ndarray | None = None, parameters: dict | None = None, inputs: tuple = ()) -> None:
+    """Write the product atomically (see the module docstring)."""
+    n, m = image_before.shape
+    chunks = (min(n, 256), min(m, 1024))
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
+        f.attrs["epoch_utc"] = epoch_utc
+        f.attrs["t_ref_s"] = float(t_ref_s)
+        f.attrs["frame"] = "LOCAL"
+        f.attrs["look_side"] = look_side
+        f.attrs["detection"] = json.dumps(to_jsonable(detection), sort_keys=True)
+        f.attrs["movers_json"] = json.dumps(to_jsonable(movers), sort_keys=True)
+        dataset(f, "azimuth_time", np.asarray(azimuth_time, np.float64), units="s",
+                description="zero-Doppler time after epoch_utc")
+        dataset(f, "slant_range", np.asarray(slant_range, np.float64), units="m",
+                description="closest-approach slant range")
+        dataset(f, "image_before", np.asarray(image_before, np.complex64), units="1", chunks=chunks,
+                description="channel-0 RD image, stationary-scene focusing")
+        if image_after is not None:
+            dataset(f, "image_after", np.asarray(image_after, np.complex64), units="1", chunks=chunks,
+                    description="movers compensated and relocated")
+        dataset(f, "ati_phase", np.asarray(ati_phase, np.float32), units="rad", chunks=chunks,
+                description="arg(Z1 conj(Z0)), co-registered, channel 1 ahead")
+        dataset(f, "movers", _table(movers), description="one row per mover, SI units, 1-sigma uncertainties")
+
+
+def read_ati(path: str | os.PathLike) -> dict[str, Any]:
+    """The product as a dict (arrays loaded); a malformed file raises ProductError (one line)."""
+    with open_product(path, PRODUCT_TYPE) as f:
+        out: dict[str, Any] = {
+            "epoch_utc": attr_str(f, "epoch_utc"), "t_ref_s": float(f.attrs["t_ref_s"]),
+            "look_side": attr_str(f, "look_side"),
+            "detection": json.loads(attr_str(f, "detection") or "{}"),
+            "movers": json.loads(attr_str(f, "movers_json") or "[]"),
+        }
+        for k in ("azimuth_time", "slant_range", "image_before", "ati_phase", "movers_table"):
+            name = "movers" if k == "movers_table" else k
+            out[k] = require(f, name, path)[()]
+        out["image_after"] = f["image_after"][()] if "image_after" in f else None
+        return out
