@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 import typer
 from typer.core import TyperGroup
 
+from orbit.errors import OrbitError
 from sarcli.errors import SarcliError
 from sarcli.io.h5common import to_jsonable
 
@@ -32,6 +33,8 @@ class SarcliGroup(TyperGroup):
             return super().invoke(ctx)
         except SarcliError as e:
             raise fail(str(e), e.exit_code) from None
+        except OrbitError as e:  # impossible geometry / bad state vectors from the orbit package
+            raise fail(str(e)) from None
         except (FileNotFoundError, PermissionError, IsADirectoryError) as e:
             name = getattr(e, "filename", None)
             raise fail(f"{name}: {e.strerror}" if name else str(e)) from None
