@@ -8,6 +8,8 @@ import struct
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from orbit.frames import eci_to_ecef
 from orbit.timeutil import parse_utc
@@ -147,3 +149,63 @@ def test_window_start_picks_pulses_in_flight_from_dwp(make_raw, tmp_path):
     write_ceos(tmp_path / "s", raw)
     x = read_ceos(tmp_path / "s").extra_attrs
     assert (x["ceos_pulses_in_flight"], x["ceos_window_start_code"], x["ceos_beam_name"]) == (9, 300, "FN4")
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(adc=st.integers(0, 2), prf_code=st.integers(1500, 8191), n_p=st.integers(7, 11),
+       n_lines=st.integers(1, 20), k6=st.integers(1, 8), seed=st.integers(0, 2**16),
+       epoch_us=st.integers(0, 86_400_000_000 - 1), skips=st.lists(st.integers(1, 4), min_size=0, max_size=3))
+def test_roundtrip_property_over_codes(make_raw, tmp_path_factory, adc, prf_code, n_p, n_lines, k6, seed,
+                                       epoch_us, skips):
+    """Any code-exact timing, line count, width (6k), epoch and set of skipped pulses reads back exactly."""
+    from hypothesis import assume
+
+    pri = 1 / float(A.prf_from_code(prf_code, adc))
+    step = 6 * float(A.clock_period_s(adc))
+    w = int(min(4095, (pri * 0.5) / step))  # a DWP inside the PRI
+    assume(w > 0)
+    epoch = (_dt.datetime(2003, 3, 1, tzinfo=_dt.UTC) + _dt.timedelta(microseconds=epoch_us)).strftime(
+        "%Y-%m-%dT%H:%M:%S.%fZ")
+    raw = make_raw(n_lines=n_lines, n_samples=6 * k6, seed=seed, epoch=epoch, replica=seed % 2 == 0)
+    r = raw.radar
+    r.range_sampling_rate_hz = 1 / float(A.clock_period_s(adc))
+    r.prf_hz = 1 / pri
+    r.window_start_s = float(A.first_sample_time(w, prf_code, adc, n_p))
+    r.first_range_m = A.C_LIGHT * r.window_start_s / 2
+    if raw.replica is not None:
+        raw.replica = raw.replica[:1].repeat(A.replica_samples(adc))
+    pulses = np.arange(n_lines)
+    for k, s in enumerate(skips):  # skip s pulses after line (k+1)*n_lines//4
+        pulses[(k + 1) * n_lines // 4:] += s
+    raw.azimuth_time = pulses / r.prf_hz
+    folder = tmp_path_factory.mktemp("prop")
+    write_ceos(folder / "s", raw)
+    back = read_ceos(folder / "s", missing="keep")
+    assert np.array_equal(back.echo, raw.echo)
+    assert np.max(np.abs(abs_times(back) - abs_times(raw))) <= 0.5e-6 + 1e-9
+    assert back.radar.prf_hz == r.prf_hz and back.radar.range_sampling_rate_hz == r.range_sampling_rate_hz
+    assert back.radar.window_start_s == pytest.approx(r.window_start_s, rel=1e-13)
+    assert back.extra_attrs["ceos_missing_lines"] == pulses[-1] - pulses[0] + 1 - n_lines
+    if raw.replica is not None and n_lines > 6:  # replica lines are 7, 15, ...
+        assert np.array_equal(back.replica, raw.replica)
+    else:
+        assert back.replica is None
+
+
+def test_clock_jitter_does_not_enter_the_azimuth_grid(make_raw, tmp_path):
+    raw = make_raw(n_lines=16, replica=False)
+    _, dat = write_ceos(tmp_path / "s", raw)
+    b = bytearray(dat.read_bytes())
+    rec = 242 + 192  # every record is 434 bytes here (96 samples, no replica)
+    for k in (3, 9):  # add 40 us to the aux clock of lines 4 and 10 (40 us << 1/PRF = 796 us)
+        aux = np.frombuffer(bytes(b[16252 + k * rec + 192:16252 + k * rec + 242]), np.uint8).reshape(1, 50).copy()
+        us = int(A.get_field(aux, "milliseconds")[0]) * 1000 + int(A.get_field(aux, "microseconds")[0]) + 40
+        A.set_field(aux, "milliseconds", us // 1000)
+        A.set_field(aux, "microseconds", us % 1000)
+        assert us // 1000 < 1000
+        b[16252 + k * rec + 192:16252 + k * rec + 242] = aux.tobytes()
+    dat.write_bytes(bytes(b))
+    back = read_ceos(tmp_path / "s")
+    assert back.extra_attrs["ceos_missing_lines"] == 0 and np.array_equal(back.echo, raw.echo)
+    assert np.allclose(np.diff(back.azimuth_time), 1 / raw.radar.prf_hz, rtol=0, atol=1e-12)
+    assert back.extra_attrs["ceos_time_residual_max_s"] == pytest.approx(40e-6, abs=1.5e-6)

@@ -75,6 +75,13 @@ def test_not_a_ceos_file(cli, scene, tmp_path):
                    "not a CEOS data file")
     one_line_error(cli("ingest", dat, lea, "-o", tmp_path / "o.h5"), "leader and data swapped?")
     one_line_error(cli("ingest", tmp_path, "-o", tmp_path / "o.h5"), "no LEA_01.001")
+    empty = tmp_path / "empty.001"
+    empty.write_bytes(b"")
+    one_line_error(cli("ingest", lea, empty, "-o", tmp_path / "o.h5"), "empty file")
+    one_line_error(cli("ingest", lea, tmp_path / "nope.001", "-o", tmp_path / "o.h5"), "no such file")
+    short = tmp_path / "short.001"
+    short.write_bytes(dat.read_bytes()[:5000])  # inside the 16252-byte descriptor
+    one_line_error(cli("ingest", lea, short, "-o", tmp_path / "o.h5"), "file descriptor claims 16252 bytes")
     assert not (tmp_path / "o.h5").exists()
 
 
