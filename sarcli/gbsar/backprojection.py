@@ -6,11 +6,12 @@ the baseband range profiles P_i of :mod:`sarcli.gbsar.rangecomp` (``P_i(R) = a e
 
     g(x, R0) = exp(-j 4 pi R0/lam) * sum_i w_i P_i(R_i) exp(+j 4 pi R_i/lam) / sum_i w_i
 
-so a scatterer focuses to its reflectivity (times the window's coherent gain) with the phase
+over the stops of the pixel's synthetic aperture (rail within the beam footprint, seed 000 Fig. 2),
+``w_i`` the azimuth taper over that aperture, so a scatterer focuses to its (pattern-weighted)
+reflectivity with the phase
 ``-4 pi R0/lam`` of seed 000's RD image (eq. 21) at every range: no approximation but the linear
 interpolation of the (oversampled) profile and the centre wavelength in the carrier term, which is
-exact because the profile is referenced to f_c. ``w_i`` is the azimuth window over the rail times
-the stop validity.
+exact because the profile is referenced to f_c. Flagged stops are left out.
 """
 
 from __future__ import annotations
@@ -18,23 +19,41 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from sarcli.gbsar.rangecomp import RangeProfiles, window
+from sarcli.errors import SarcliError
+from sarcli.gbsar.rangecomp import RangeProfiles
+
+WINDOW_CODE = {"none": 0, "hamming": 1, "hann": 2}
+
+
+@njit(cache=True)
+def _taper(code, t):
+    if code == 1:
+        return 0.54 - 0.46 * np.cos(2.0 * np.pi * t)
+    if code == 2:
+        return 0.5 - 0.5 * np.cos(2.0 * np.pi * t)
+    return 1.0
 
 
 @njit(cache=True, parallel=True)
-def bp_kernel(prof, dr, xs, dz, wts, px, pr, kc, out):
-    """Backproject ``prof`` (n_stops, n_r) complex64 (ranges n*dr) onto pixels (px, pr) -> out (n_p,)."""
+def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, wcode, out):
+    """Backproject ``prof`` (n_stops, n_r) complex64 (ranges n*dr) onto pixels (px, pr) -> out (n_p,).
+
+    Each pixel integrates the stops of its synthetic aperture ``[a, b]`` = rail ``[xs[0], xs[-1]]``
+    intersected with the beam footprint ``|x - px| <= half_beam * pr`` (seed 000 eq. 22-40), weighted by
+    the taper ``wcode`` over [a, b] and normalized by the sum of the weights used.
+    """
     n_s, n_r = prof.shape
-    wsum = 0.0
-    for i in range(n_s):
-        wsum += wts[i]
-    scale = 1.0 / wsum if wsum > 0 else 0.0
     for p in prange(px.shape[0]):
+        a = max(xs[0], px[p] - half_beam * pr[p])
+        b = min(xs[n_s - 1], px[p] + half_beam * pr[p])
+        span = b - a
         acc = 0j
+        wsum = 0.0
         r0sq = pr[p] * pr[p]
         for i in range(n_s):
-            if wts[i] == 0.0:
+            if valid[i] == 0.0 or xs[i] < a or xs[i] > b:
                 continue
+            w = _taper(wcode, (xs[i] - a) / span) if span > 0 else 1.0
             d = px[p] - xs[i]
             r = np.sqrt(d * d + r0sq + dz[i] * dz[i])
             f = r / dr
@@ -43,31 +62,39 @@ def bp_kernel(prof, dr, xs, dz, wts, px, pr, kc, out):
                 continue
             t = f - j
             v = prof[i, j] * (1.0 - t) + prof[i, j + 1] * t
-            acc += wts[i] * v * np.exp(1j * kc * r)
-        out[p] = acc * np.exp(-1j * kc * pr[p]) * scale
+            acc += w * v * np.exp(1j * kc * r)
+            wsum += w
+        out[p] = acc * np.exp(-1j * kc * pr[p]) / wsum if wsum > 0 else 0j
 
 
-def bp_reference(prof: np.ndarray, dr: float, xs, dz, wts, px, pr, kc) -> np.ndarray:
+def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, wcode) -> np.ndarray:
     """Plain-numpy reference of :func:`bp_kernel`."""
     rgrid = np.arange(prof.shape[1]) * dr
+    a = np.maximum(xs[0], px - half_beam * pr)
+    b = np.minimum(xs[-1], px + half_beam * pr)
+    span = b - a
     acc = np.zeros(px.shape, np.complex128)
+    wsum = np.zeros(px.shape)
     for i in range(prof.shape[0]):
-        if wts[i] == 0:
-            continue
+        t = np.where(span > 0, (xs[i] - a) / np.where(span > 0, span, 1.0), 0.0)
+        w = {0: np.ones_like(t), 1: 0.54 - 0.46 * np.cos(2 * np.pi * t), 2: 0.5 - 0.5 * np.cos(2 * np.pi * t)}[wcode]
         r = np.sqrt((px - xs[i]) ** 2 + pr ** 2 + dz[i] ** 2)
-        inside = r < rgrid[-1]
+        use = (valid[i] != 0) & (xs[i] >= a) & (xs[i] <= b) & (r < rgrid[-1])
         v = np.interp(r, rgrid, prof[i].real) + 1j * np.interp(r, rgrid, prof[i].imag)
-        acc += np.where(inside, wts[i] * v * np.exp(1j * kc * r), 0)
-    return acc * np.exp(-1j * kc * pr) / np.sum(wts)
+        acc += np.where(use, w * v * np.exp(1j * kc * r), 0)
+        wsum += np.where(use, w, 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(wsum > 0, acc * np.exp(-1j * kc * pr) / wsum, 0)
 
 
-def stop_weights(prof: RangeProfiles, azimuth_window: str) -> np.ndarray:
-    """Azimuth window over the rail stops times stop validity (float64, n_stops)."""
-    return window(azimuth_window, prof.positions_m.size) * prof.weights
+def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_length_m: float | None,
+                azimuth_window: str = "hamming") -> np.ndarray:
+    """BP onto pixels at azimuth ``px`` and range ``pr`` (any equal shapes) -> complex64 of that shape.
 
-
-def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, azimuth_window: str = "hamming") -> np.ndarray:
-    """BP onto pixels at azimuth ``px`` and range ``pr`` (any equal shapes) -> complex64 of that shape."""
+    ``antenna_length_m`` = L_x limits each pixel's aperture to the beam footprint; None uses the whole rail.
+    """
+    if azimuth_window not in WINDOW_CODE:
+        raise SarcliError(f"unknown window '{azimuth_window}' (use {', '.join(WINDOW_CODE)})")
     px = np.asarray(px, np.float64)
     shape = px.shape
     flat_x = np.ascontiguousarray(px.ravel())
@@ -75,6 +102,7 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, azimuth_win
     out = np.zeros(flat_x.size, np.complex64)
     dz = prof.heights_m - prof.heights_m.mean()
     kc = 4 * np.pi / prof.wavelength_m
-    bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz,
-              stop_weights(prof, azimuth_window), flat_x, flat_r, kc, out)
+    half = prof.wavelength_m / (2 * antenna_length_m) if antenna_length_m else 1e30
+    bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
+              half, WINDOW_CODE[azimuth_window], out)
     return out.reshape(shape)

@@ -26,8 +26,7 @@ import numpy as np
 import scipy.fft
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar.backprojection import stop_weights
-from sarcli.gbsar.rangecomp import RangeProfiles
+from sarcli.gbsar.rangecomp import RangeProfiles, stop_weights
 from sarcli.gbsar.system import next_pow2
 
 

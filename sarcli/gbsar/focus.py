@@ -51,6 +51,7 @@ class FocusOptions:
     bp_oversample: int = 4
     rd_oversample: int = 2
     df_oversample: int = 2
+    beam_limited: bool = True
 
 
 @dataclass
@@ -91,7 +92,8 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
 def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> np.ndarray:
     prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
-    return backproject(prof, px, pr, opts.azimuth_window)
+    return backproject(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
+                       opts.azimuth_window)
 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:

@@ -102,3 +102,8 @@ def range_compress(scan: Scan, pol: str, window_name: str = "hamming", oversampl
                          frequency_step_hz=df, n_freq=n_r, positions_m=np.asarray(scan.rail_position, np.float64),
                          heights_m=np.asarray(scan.rail_height, np.float64), weights=(~bad).astype(np.float64),
                          skipped=[int(i) for i in np.flatnonzero(bad)])
+
+
+def stop_weights(prof: RangeProfiles, azimuth_window: str) -> np.ndarray:
+    """Azimuth window over the rail stops times stop validity (float64, n_stops)."""
+    return window(azimuth_window, prof.positions_m.size) * prof.weights

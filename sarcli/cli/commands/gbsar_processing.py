@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import typer
 
 from sarcli.cli.common import emit_json, info, progress
@@ -29,8 +30,6 @@ def simulate_cmd(
 
       sarcli gbsar simulate samples/gbsar_outdoor.toml -o t1.h5 --json
     """
-    import numpy as np
-
     from sarcli.gbsar.scene import load_scene
     from sarcli.gbsar.simulate import simulate
     from sarcli.gbsar.system import system_from_scene
@@ -174,8 +173,6 @@ def focus_cmd(
     """
     import math
 
-    import numpy as np
-
     from sarcli.gbsar.focus import FocusOptions, focus_scan
     from sarcli.io.gbsar_image import GbsarImage, write_gbsar_image
     from sarcli.io.scan import read_scan
@@ -228,6 +225,239 @@ def _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quickloo
         write_quicklook(quicklook, img.image[0], title=f"GB-SAR {img.polarizations[0]} ({img.algorithm})",
                         extent=[img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]],
                         xlabel="azimuth x (m)", ylabel="range R0 (m)", aspect="auto")
+
+
+def _load_image(path: Path, algorithm: str = "auto", max_range: float | None = None):
+    """A focused image product, or a scan focused on the fly with ``algorithm`` (default grid)."""
+    from sarcli.io.h5common import attr_str, open_product
+
+    with open_product(path, ("gbsar_image", "gbsar_scan")) as f:
+        kind = attr_str(f, "product_type")
+    if kind == "gbsar_image":
+        from sarcli.io.gbsar_image import read_gbsar_image
+
+        return read_gbsar_image(path)
+    from sarcli.gbsar.focus import FocusOptions, focus_scan
+    from sarcli.io.gbsar_image import GbsarImage
+    from sarcli.io.scan import read_scan
+
+    s = read_scan(path)
+    f = focus_scan(s, FocusOptions(algorithm=algorithm, max_range_m=max_range))
+    fr = s.frequency
+    return GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
+                      polarizations=tuple(f.report["polarizations"]), algorithm=algorithm,
+                      center_frequency_hz=float(0.5 * (fr[0] + fr[-1])),
+                      frequency_step_hz=float((fr[-1] - fr[0]) / max(fr.size - 1, 1)), n_freq=int(fr.size),
+                      rail_height_m=float(np.mean(s.rail_height)),
+                      rail_centre_m=float(0.5 * (s.rail_position[0] + s.rail_position[-1])),
+                      rail_length_m=float(s.rail_position[-1] - s.rail_position[0]), epoch_utc=s.epoch_utc,
+                      scan_time_s=float(np.mean(s.stop_time)) if s.stop_time is not None else 0.0,
+                      site=s.site, report=f.report)
+
+
+def _map_outputs(raster, img, geotiff: Path | None, png: Path | None, title: str, label: str, cmap: str,
+                 vmin: float, vmax: float, map_pixel: float | None) -> dict:
+    """UTM GeoTIFF (nearest resampling) and slant-plane PNG of a real-valued raster on ``img``'s grid."""
+    from sarcli.gbsar.geocode import resample_to_map
+    from sarcli.io.images import write_geotiff, write_quicklook
+
+    out = {}
+    if geotiff is not None:
+        pixel = map_pixel or float(img.range_m[1] - img.range_m[0])
+        m, transform, crs, ginfo = resample_to_map(raster, img.range_m, img.azimuth_m, img.site, img.rail_height_m,
+                                                   img.rail_centre_m, pixel, "utm")
+        write_geotiff(geotiff, m, crs, transform=transform, band_description=label)
+        out["geotiff"] = {"path": str(geotiff), "crs": crs, **ginfo}
+    if png is not None:
+        write_quicklook(png, raster, title=title, cmap=cmap, is_db=True, vmin=vmin, vmax=vmax,
+                        extent=[img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]],
+                        xlabel="azimuth x (m)", ylabel="range R0 (m)", colorbar_label=label)
+        out["png"] = str(png)
+    return out
+
+
+@gbsar_app.command("interfere")
+def interfere_cmd(
+    reference: Path = typer.Argument(..., help="Reference image (or scan) A."),
+    secondary: Path = typer.Argument(..., help="Secondary image (or scan) B; the interferogram is B * conj(A)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Output interferogram product (.h5)."),
+    mode: str = typer.Option("dinsar", "--mode", help="dinsar | crosstrack | deltaf | combined."),
+    pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of A]."),
+    window: int = typer.Option(5, "--window", help="Coherence boxcar window (pixels)."),
+    ground_height: float = typer.Option(0.0, "--ground-height", help="Reference surface height z (m) of the model."),
+    geotiff: Path = typer.Option(None, "--geotiff", help="UTM GeoTIFF of the residual phase (rad)."),
+    png: Path = typer.Option(None, "--png", help="PNG of the residual phase (cyclic colour map)."),
+    value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m)."),
+    map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
+    json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
+) -> None:
+    """Interferogram of two GB-SAR images: phase, coherence, model phase removed, converted value.
+
+    dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m).
+    Scans given instead of images are focused with --algorithm auto first.
+
+    Examples:
+
+      sarcli gbsar interfere t2.h5 t3.h5 --mode crosstrack -o xt.h5 --png xt.png --geotiff xt.tif
+
+      sarcli gbsar interfere t1.h5 t2.h5 --mode dinsar -o dinsar.h5 --json
+    """
+    from sarcli.gbsar.interferometry import interfere
+
+    a, b = _load_image(reference), _load_image(secondary)
+    pol = (pol or a.polarizations[0]).upper()
+    ifg = interfere(a, b, mode, pol, window, ground_height)
+    attrs = {"mode": mode, "pol": pol, "coherence_window": window, "ground_height_m": ground_height,
+             "rail_height_a_m": a.rail_height_m, "rail_height_b_m": b.rail_height_m,
+             "center_frequency_a_hz": a.center_frequency_hz, "center_frequency_b_hz": b.center_frequency_hz,
+             "epoch_utc": a.epoch_utc}
+    from sarcli.io.interferogram import write_interferogram
+
+    write_interferogram(output, ifg, a.range_m, a.azimuth_m, attrs, parameters=attrs, inputs=[reference, secondary])
+    summary = {"output": str(output), **attrs, "value": ifg.value_name, "unit": ifg.value_unit, "rate": ifg.rate,
+               "mean_coherence": float(np.nanmean(ifg.coherence))}
+    summary.update(_map_outputs(ifg.residual, a, geotiff, png, f"{mode} residual phase ({pol})", "phase (rad)",
+                                "twilight", -np.pi, np.pi, map_pixel))
+    if value_png is not None:
+        v = ifg.value[np.isfinite(ifg.value)]
+        lo, hi = (np.percentile(v, [2, 98]) if v.size else (0.0, 1.0))
+        _map_outputs(ifg.value, a, None, value_png, f"{mode} {ifg.value_name}", f"{ifg.value_name} ({ifg.value_unit})",
+                     "viridis", float(lo), float(hi), None)
+    if json_out:
+        emit_json(summary)
+    else:
+        info(f"wrote {output}: {mode}, mean coherence {summary['mean_coherence']:.3f}, value {ifg.value_name} "
+             f"({ifg.value_unit})")
+
+
+@gbsar_app.command("coherence")
+def coherence_cmd(
+    images: list[Path] = typer.Argument(..., help="Two or more images (or scans) of the same geometry, in time order."),
+    output: Path = typer.Option(..., "-o", "--output", help="Output PS product (.h5)."),
+    threshold: float = typer.Option(0.9, "--threshold", help="Temporal coherence threshold for PS."),
+    dynamic_range_db: float = typer.Option(40.0, "--dynamic-range-db",
+                                           help="PS amplitude floor below the brightest pixel (dB)."),
+    pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of the first image]."),
+    csv: Path = typer.Option(None, "--csv", help="CSV of the PS time series."),
+    plot: Path = typer.Option(None, "--plot", help="PNG: coherence map and PS displacement series."),
+    json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
+) -> None:
+    """Temporal coherence |sum z|/sum|z|, persistent-scatterer selection and PS phase/displacement series.
+
+    Examples:
+
+      sarcli gbsar coherence p1.h5 p2.h5 p3.h5 p4.h5 --threshold 0.99 -o ps.h5 --csv ps.csv --plot ps.png
+    """
+    from sarcli.errors import SarcliError
+    from sarcli.gbsar.interferometry import check_compatible
+    from sarcli.gbsar.timeseries import ps_series, select_ps, temporal_coherence
+    from sarcli.io.interferogram import write_ps
+
+    if len(images) < 2:
+        raise SarcliError("coherence needs at least 2 images")
+    imgs = [_load_image(p) for p in images]
+    pol = (pol or imgs[0].polarizations[0]).upper()
+    for other in imgs[1:]:
+        check_compatible(imgs[0], other, "dinsar", pol)
+    stack = np.stack([im.pol(pol) for im in imgs])
+    gamma = temporal_coherence(stack)
+    rows, cols = select_ps(gamma, np.mean(np.abs(stack), axis=0), threshold, dynamic_range_db)
+    phase, disp = ps_series(stack, rows, cols, imgs[0].wavelength_m)
+    t = np.array([_seconds_between(imgs[0].epoch_utc, im.epoch_utc) + im.scan_time_s for im in imgs])
+    attrs = {"pol": pol, "threshold": threshold, "dynamic_range_db": dynamic_range_db, "epoch_utc": imgs[0].epoch_utc}
+    write_ps(output, gamma, t, rows, cols, imgs[0].range_m, imgs[0].azimuth_m, phase, disp, attrs,
+             parameters=attrs, inputs=images)
+    if csv is not None:
+        _write_ps_csv(csv, imgs[0], rows, cols, gamma, phase, disp)
+    if plot is not None:
+        _ps_plot(plot, imgs[0], gamma, rows, cols, t, disp)
+    summary = {"output": str(output), "n_images": len(imgs), "n_ps": int(rows.size), "threshold": threshold,
+               "max_abs_phase_change_deg": float(np.degrees(np.max(np.abs(phase)))) if rows.size else None,
+               "time_s": t}
+    if json_out:
+        emit_json(summary)
+    else:
+        info(f"wrote {output}: {rows.size} PS of {gamma.size} pixels (gamma >= {threshold})")
+
+
+def _seconds_between(a: str, b: str) -> float:
+    from datetime import datetime
+
+    from sarcli.errors import SarcliError
+
+    try:
+        ta, tb = (datetime.fromisoformat(x.replace("Z", "+00:00")) for x in (a, b))
+    except ValueError:
+        raise SarcliError(f"unreadable epoch_utc '{a}' or '{b}'") from None
+    return (tb - ta).total_seconds()
+
+
+def _write_ps_csv(path: Path, img, rows, cols, gamma, phase, disp) -> None:
+    import csv as _csv
+    import os
+    import tempfile
+
+    n = phase.shape[1] if phase.ndim == 2 else 0
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent if str(path.parent) else ".")
+    with os.fdopen(fd, "w", newline="") as fh:
+        w = _csv.writer(fh)
+        w.writerow(["ps", "azimuth_m", "range_m", "coherence"] + [f"phase_deg_{i}" for i in range(n)]
+                   + [f"displacement_mm_{i}" for i in range(n)])
+        for k, (r, c) in enumerate(zip(rows, cols, strict=True)):
+            w.writerow([k, f"{img.azimuth_m[c]:.3f}", f"{img.range_m[r]:.3f}", f"{gamma[r, c]:.5f}"]
+                       + [f"{v:.3f}" for v in np.degrees(phase[k])] + [f"{v:.4f}" for v in disp[k]])
+    os.replace(tmp, path)
+
+
+def _ps_plot(path: Path, img, gamma, rows, cols, t, disp) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 5), dpi=100)
+    im = a1.imshow(gamma, vmin=0, vmax=1, cmap="viridis", aspect="auto", interpolation="nearest",
+                   extent=[img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]])
+    a1.plot(img.azimuth_m[cols], img.range_m[rows], "r.", ms=3, label="PS")
+    a1.set(xlabel="azimuth x (m)", ylabel="range R0 (m)", title="temporal coherence")
+    fig.colorbar(im, ax=a1)
+    for k in range(min(rows.size, 20)):
+        a2.plot(np.asarray(t) / 60.0, disp[k], ".-")
+    a2.set(xlabel="time (min)", ylabel="LOS displacement (mm)", title=f"{rows.size} PS (first 20 shown)")
+    fig.tight_layout()
+    from sarcli.io.images import _atomic_path
+
+    with _atomic_path(path, ".png") as tmp:
+        fig.savefig(tmp, format="png")
+    plt.close(fig)
+
+
+@gbsar_app.command("polarimetry")
+def polarimetry_cmd(
+    image: Path = typer.Argument(..., help="Image (or scan) with HH and VV."),
+    geotiff: Path = typer.Option(None, "--geotiff", help="UTM GeoTIFF of (HH-VV)/(HH+VV)."),
+    png: Path = typer.Option(None, "--png", help="PNG of (HH-VV)/(HH+VV) in the slant plane."),
+    window: int = typer.Option(3, "--window", help="Boxcar window (pixels) for the powers."),
+    map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
+    json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
+) -> None:
+    """Polarimetric normalized difference (|HH|^2-|VV|^2)/(|HH|^2+|VV|^2) image (seed 003).
+
+    Examples:
+
+      sarcli gbsar polarimetry image.h5 --png nd.png --geotiff nd.tif
+    """
+    from sarcli.gbsar.timeseries import normalized_difference
+
+    img = _load_image(image)
+    nd = normalized_difference(img.pol("HH"), img.pol("VV"), window)
+    summary = {"mean": float(np.nanmean(nd)), "fraction_hh_dominant": float(np.nanmean(nd > 0))}
+    summary.update(_map_outputs(nd, img, geotiff, png, "(HH-VV)/(HH+VV)", "normalized difference", "RdBu_r",
+                                -1.0, 1.0, map_pixel))
+    if json_out:
+        emit_json(summary)
+    else:
+        info(f"normalized difference: mean {summary['mean']:.3f}")
 
 
 def register(app: typer.Typer) -> None:
