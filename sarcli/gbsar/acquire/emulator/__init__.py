@@ -84,6 +84,8 @@ class Emulator:
         return self.fixed_pol
 
     def start(self) -> Emulator:
+        # one evaluation first, so that a JIT-compiled source does not delay the first sweep's OPC
+        self.vna.source(self.rail_position_m(), np.array([5.0e9, 5.1e9]), self.polarization())
         self.service.start()
         return self
 
