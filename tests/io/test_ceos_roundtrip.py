@@ -55,6 +55,7 @@ def test_roundtrip_is_exact(make_raw, tmp_path):
     x = back.extra_attrs
     assert (x["ceos_prf_code"], x["ceos_window_start_code"], x["ceos_beam_name"]) == (4283, 1262, "FN1")
     assert x["ceos_replica_lines"].tolist() == list(range(6, 40, 8)) and x["ceos_missing_lines"] == 0
+    assert abs(x["ceos_gha_minus_gmst_deg"]) < 1e-9
     assert lea.name == "LEA_01.001" and dat.name == "DAT_01.001"
     assert sorted(p.name for p in (tmp_path / "scene").iterdir()) == [
         "DAT_01.001", "LEA_01.001", "TRA_01.001", "VDF_DAT.001"]

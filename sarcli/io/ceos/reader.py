@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from orbit.frames import gmst
 from orbit.timeutil import format_utc
 from sarcli.errors import FormatError
 from sarcli.io.ceos import aux as A
@@ -241,7 +242,11 @@ def read_ceos(leader: str | os.PathLike, data: str | os.PathLike | None = None, 
         "ceos_bad_sync_lines": int(np.sum(a["sync"] != A.AUX_SYNC)),
     }
     if gha is not None:
+        # The format does not say which equinox its "inertial" frame uses; the difference between the
+        # delivered hour angle and sarcli's GMST at the first vector shows it (0 for sarcli's writer).
+        gmst_deg = float(np.degrees(gmst(format_utc(first_time), orbit.time[0])))
         extra["ceos_gha_deg"] = gha
+        extra["ceos_gha_minus_gmst_deg"] = (gha - gmst_deg + 180.0) % 360.0 - 180.0
     look = "left" if (info.clock_angle_deg is not None and info.clock_angle_deg < 0) else "right"
     return RawProduct(
         echo=echo, azimuth_time=azimuth_time.astype(np.float64), epoch_utc=format_utc(first_time),
