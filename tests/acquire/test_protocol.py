@@ -194,3 +194,24 @@ def test_fault_plan_parsing_and_counting():
     assert plan.event("move") == {"alarm": 9.0}
     assert [plan.event("sweep") for _ in range(3)][-1] == {"slow-sweep": 4.0}
     assert plan.fired == ["garble@2", "alarm@1", "slow-sweep@3"]
+
+
+def test_locked_rail_is_unlocked_and_homed(cli, emulator, config_path, tmp_path):
+    """GRBL with homing enabled starts in Alarm ('$H'|'$X' to unlock): the driver unlocks, homes when
+    configured, then scans."""
+    config_path.write_text(config_path.read_text().replace("[rail]\n", "[rail]\nhome = true\n"))
+    emu = emulator(start_locked=True, grbl_settings={130: 1500.0, 22: 1.0})
+    r = cli("gbsar", "scan", "--port", emu.vna_port, "--rail-port", emu.rail_port, "-c", config_path,
+            "-o", tmp_path / "h.h5", "--count", "2")
+    assert r.exit_code == 0, r.stderr
+    lines = [x for x in emu.grbl.log if len(x) != 1]
+    assert lines.index("$X") < lines.index("$H") < lines.index("G1 X0.000 F500")
+
+
+def test_homing_disabled_is_refused(cli, emulator, config_path, tmp_path):
+    config_path.write_text(config_path.read_text().replace("[rail]\n", "[rail]\nhome = true\n"))
+    emu = emulator()  # $22 = 0
+    r = cli("gbsar", "scan", "--port", emu.vna_port, "--rail-port", emu.rail_port, "-c", config_path,
+            "-o", tmp_path / "h.h5")
+    assert r.exit_code == 3 and "error:5 (homing not enabled)" in r.stderr
+    assert not any(x.startswith("G1") for x in emu.grbl.log) and not (tmp_path / "h.h5").exists()

@@ -44,6 +44,18 @@ def test_full_scan_matches_simulator_and_focuses(cli, emulator, config_path, sce
             i = np.unravel_index(np.argmax(a), a.shape)
             assert abs(X[i] - tx) <= 0.03 and abs(R[i] - ty) <= 0.03, (pol, X[i], R[i])
 
+    # and with the project's GB-SAR focusing (backprojection onto a slant-plane grid)
+    from sarcli.gbsar.focus import FocusOptions, Grid, focus_scan
+
+    grid = Grid(ranges=np.arange(3.0, 7.5, 0.025), azimuths=np.arange(-1.0, 1.0, 0.025))
+    foc = focus_scan(s, FocusOptions(algorithm="bp", max_range_m=8.0), grid)
+    for ip, pol in enumerate(s.polarizations):
+        a = np.abs(foc.image[ip])
+        for tx, ty in ((-0.3, 4.0), (0.25, 6.5)):
+            near = (np.abs(grid.ranges[:, None] - ty) < 0.4) & (np.abs(grid.azimuths[None, :] - tx) < 0.3)
+            i, j = np.unravel_index(np.argmax(np.where(near, a, 0)), a.shape)
+            assert abs(grid.azimuths[j] - tx) <= 0.05 and abs(grid.ranges[i] - ty) <= 0.05, (pol, i, j)
+
 
 def backprojection(s21, f, x, xc, rc, half=0.3, n=61, n_fft=8192):
     """|image| on an n x n grid around (xc, rc): IFFT range profiles, linear interpolation in range,
