@@ -109,6 +109,9 @@ def summarize(path: Path) -> dict[str, Any]:
             "epoch_utc": attrs.get("epoch_utc"), "source": attrs.get("source"),
             "provenance": prov, "attributes": attrs, "datasets": datasets,
         }
+        summary["time_spans"] = {
+            d["path"]: _time_span(f, d["path"], summary["epoch_utc"]) for d in datasets
+            if d["units"] == "s" and len(d["shape"]) == 1 and "time" in d["path"].rsplit("/", 1)[-1]}
         if prov["product_type"] == "raw" and "echo" in f:
             summary["main_dataset"] = "/echo"
             _raw_summary(f, summary)
@@ -134,6 +137,9 @@ def _human(s: dict[str, Any]) -> None:
         else:
             say("  orbit: none")
     else:
+        for name, span in s["time_spans"].items():
+            if span:
+                say(f"  {name}: {span['start_utc']} .. {span['stop_utc']} ({span['span_s']:.3f} s)")
         for d in s["datasets"]:
             say(f"  {d['path']}: {d['dtype']} {d['shape']}" + (f" [{d['units']}]" if d["units"] else ""))
 
