@@ -126,7 +126,7 @@ def emulate_cmd(
     machine_zero: float = typer.Option(None, "--machine-zero", help="Rail-frame position (m) of GRBL X0 "
                                        "(default: the scene's first stop, else 0)."),
     height: float = typer.Option(None, "--height", help="Antenna height, m (default: the scene's)."),
-    max_travel_mm: float = typer.Option(2000.0, "--max-travel-mm", help="GRBL $130."),
+    max_travel_mm: float = typer.Option(4000.0, "--max-travel-mm", help="GRBL $130 (mm)."),
     soft_limits: bool = typer.Option(False, "--soft-limits", help="$20=1: targets beyond travel raise ALARM:2."),
     json_out: bool = typer.Option(False, "--json", help='First stdout line: {"vna_port": ..., "rail_port": ...}.'),
 ) -> None:
