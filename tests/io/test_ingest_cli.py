@@ -163,6 +163,18 @@ def test_missing_state_vectors(cli, scene, tmp_path):
     d, paths = corrupt(tmp_path, lea, dat, edit_lea=blank_vector)
     one_line_error(cli("ingest", d, "-o", tmp_path / "o.h5"), "state vector 4 component 1", "blank")
 
+    def cut_platform(b):  # the platform position record ends early
+        del b[720 + 4096 + 3000:]
+
+    d, paths = corrupt(tmp_path, lea, dat, edit_lea=cut_platform)
+    one_line_error(cli("ingest", d, "-o", tmp_path / "o.h5"), "claims 8960 bytes", "truncated or corrupt")
+
+    def one_vector(b):
+        b[720 + 4096 + 140:720 + 4096 + 144] = b"   1"
+
+    d, paths = corrupt(tmp_path, lea, dat, edit_lea=one_vector)
+    one_line_error(cli("ingest", d, "-o", tmp_path / "o.h5"), "1 state vectors")
+
 
 def test_bad_options(cli, scene, tmp_path):
     _, lea, _ = scene
