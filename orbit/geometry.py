@@ -237,6 +237,26 @@ def target_from_look_plane(r, v, rho, pitch=0.0, yaw=0.0, side: str = "right", h
     return target_in_plane(r, along_track_axis(r, v, pitch, yaw, exact), 0.0, rho, side, h)
 
 
+def doppler_from_attitude(sv: StateVectors, t, rho, wavelength: float, pitch=0.0, yaw=0.0, side: str = "right",
+                          h=0.0, exact: bool = True) -> np.ndarray:
+    """Geometric Doppler centroid (Hz) of the beam centre (seed eq. 4-6, its "fdc_orbit").
+
+    At azimuth time(s) t: the target at slant range rho on the surface of height h in the control
+    frame's look plane (flight frame of the state vectors' own frame; the seed uses ECI, where zero
+    attitude means a beam perpendicular to the INERTIAL velocity), then
+    fdc = (2/lam) v_rel . (p - r)/rho with v_rel = v - w x r in ECI (v in ECEF).
+    """
+    if sv.frame == "LOCAL":
+        raise GeometryError("geometric Doppler needs ECI or ECEF state vectors, not LOCAL")
+    t = np.asarray(t, np.float64)
+    shape = np.broadcast_shapes(t.shape, np.shape(rho), np.shape(pitch), np.shape(yaw), np.shape(h))
+    r, v, _ = sv.interpolate(np.broadcast_to(t, shape))
+    p = target_from_look_plane(r, v, np.broadcast_to(rho, shape), np.broadcast_to(pitch, shape),
+                               np.broadcast_to(yaw, shape), side, np.broadcast_to(h, shape), exact)
+    vrel = relative_velocity_eci(r, v) if sv.frame == "ECI" else v
+    return doppler_hz(r, vrel, p, wavelength)
+
+
 def look_angle(r, p) -> np.ndarray:
     """Angle (rad) between the line of sight r -> p and the geodetic nadir at r."""
     d = np.asarray(p, np.float64) - np.asarray(r, np.float64)

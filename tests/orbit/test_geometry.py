@@ -204,3 +204,20 @@ def test_spherical_formulas_exact_in_the_equatorial_plane():
     assert np.abs(G.sphere_slant_range(inc, re, rs) - rho).max() < 1e-6
     with pytest.raises(GeometryError, match="horizon"):
         G.sphere_incidence_from_look(np.radians(80.0), re, rs)
+
+
+@pytest.mark.parametrize("scale", [0.0, 1.0, 100.0])
+def test_doppler_from_attitude_is_the_beam_doppler(polar_truth, scale):
+    """Seed eq. 4-6: fdc = (2/lam) v_rel . L, with L the beam that reaches slant range rho (ECI, v_rel = v - w x r)."""
+    sv = polar_truth.sv
+    t = np.array([500.0, 2500.0, 4500.0])
+    r, v, _ = sv.interpolate(t)
+    pitch, yaw = scale * RS1_PITCH, scale * RS1_YAW
+    look = np.radians(np.array([22.0, 31.0, 44.0]))
+    _, rho = G.target_from_look(r, v, look, pitch=pitch, yaw=yaw, h=300.0)
+    L = beam_vector(r, v, look, pitch, yaw)
+    expect = 2 / LAM * np.sum(G.relative_velocity_eci(r, v) * L, -1)
+    got = G.doppler_from_attitude(sv, t, rho, LAM, pitch, yaw, h=300.0)
+    assert np.abs(got - expect).max() < 1e-6
+    if scale == 0:  # zero attitude in ECI: only the Earth rotation's Doppler remains (kHz at C band)
+        assert np.all(np.abs(got) > 100.0)
