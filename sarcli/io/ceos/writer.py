@@ -144,6 +144,9 @@ def _atomic_write(folder: Path, name: str, chunks) -> Path:
         with os.fdopen(fd, "wb") as f:
             for c in chunks:
                 f.write(c)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a delivered scene is readable like any file
         os.replace(tmp, folder / name)
     except BaseException:
         with contextlib.suppress(OSError):
