@@ -182,3 +182,21 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     if opts.algorithm == "auto" and not uniform:
         report["note"] = "non-uniform rail steps: DF/RD impossible, the whole image was backprojected"
     return Focused(image=image, grid=grid, algorithm_map=amap, report=report)
+
+
+def image_from_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None = None,
+                    pols: tuple[str, ...] | None = None):
+    """Focus ``scan`` and wrap the result as a :class:`sarcli.io.gbsar_image.GbsarImage` product."""
+    from sarcli.io.gbsar_image import GbsarImage
+
+    opts = opts or FocusOptions()
+    f = focus_scan(scan, opts, grid, pols)
+    fr, x = scan.frequency, scan.rail_position
+    return GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
+                      polarizations=tuple(f.report["polarizations"]), algorithm=opts.algorithm,
+                      center_frequency_hz=float(0.5 * (fr[0] + fr[-1])),
+                      frequency_step_hz=float((fr[-1] - fr[0]) / max(fr.size - 1, 1)), n_freq=int(fr.size),
+                      rail_height_m=float(np.mean(scan.rail_height)), rail_centre_m=float(0.5 * (x[0] + x[-1])),
+                      rail_length_m=float(x[-1] - x[0]), epoch_utc=scan.epoch_utc,
+                      scan_time_s=float(np.mean(scan.stop_time)) if scan.stop_time is not None else 0.0,
+                      site=scan.site, report=f.report)

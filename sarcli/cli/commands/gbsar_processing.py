@@ -173,8 +173,8 @@ def focus_cmd(
     """
     import math
 
-    from sarcli.gbsar.focus import FocusOptions, focus_scan
-    from sarcli.io.gbsar_image import GbsarImage, write_gbsar_image
+    from sarcli.gbsar.focus import FocusOptions, image_from_scan
+    from sarcli.io.gbsar_image import write_gbsar_image
     from sarcli.io.scan import read_scan
 
     s = read_scan(scan)
@@ -184,16 +184,8 @@ def focus_cmd(
     pols = tuple(p.upper() for p in pol) if pol else None
     for p in pols or ():
         s.pol(p)
-    f = focus_scan(s, opts, pols=pols)
-    img = GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
-                     polarizations=tuple(f.report["polarizations"]), algorithm=algorithm,
-                     center_frequency_hz=float(0.5 * (s.frequency[0] + s.frequency[-1])),
-                     frequency_step_hz=float((s.frequency[-1] - s.frequency[0]) / (s.frequency.size - 1)),
-                     n_freq=int(s.frequency.size), rail_height_m=float(np.mean(s.rail_height)),
-                     rail_centre_m=float(0.5 * (s.rail_position[0] + s.rail_position[-1])),
-                     rail_length_m=float(s.rail_position[-1] - s.rail_position[0]), epoch_utc=s.epoch_utc,
-                     scan_time_s=float(np.mean(s.stop_time)) if s.stop_time is not None else 0.0,
-                     site=s.site, report=f.report)
+    img = image_from_scan(s, opts, pols=pols)
+    f = img
     write_gbsar_image(output, img, parameters=vars(opts), inputs=[scan])
     _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quicklook, f.report)
     if f.report["skipped_stops"]:
@@ -237,22 +229,10 @@ def _load_image(path: Path, algorithm: str = "auto", max_range: float | None = N
         from sarcli.io.gbsar_image import read_gbsar_image
 
         return read_gbsar_image(path)
-    from sarcli.gbsar.focus import FocusOptions, focus_scan
-    from sarcli.io.gbsar_image import GbsarImage
+    from sarcli.gbsar.focus import FocusOptions, image_from_scan
     from sarcli.io.scan import read_scan
 
-    s = read_scan(path)
-    f = focus_scan(s, FocusOptions(algorithm=algorithm, max_range_m=max_range))
-    fr = s.frequency
-    return GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
-                      polarizations=tuple(f.report["polarizations"]), algorithm=algorithm,
-                      center_frequency_hz=float(0.5 * (fr[0] + fr[-1])),
-                      frequency_step_hz=float((fr[-1] - fr[0]) / max(fr.size - 1, 1)), n_freq=int(fr.size),
-                      rail_height_m=float(np.mean(s.rail_height)),
-                      rail_centre_m=float(0.5 * (s.rail_position[0] + s.rail_position[-1])),
-                      rail_length_m=float(s.rail_position[-1] - s.rail_position[0]), epoch_utc=s.epoch_utc,
-                      scan_time_s=float(np.mean(s.stop_time)) if s.stop_time is not None else 0.0,
-                      site=s.site, report=f.report)
+    return image_from_scan(read_scan(path), FocusOptions(algorithm=algorithm, max_range_m=max_range))
 
 
 def _map_outputs(raster, img, geotiff: Path | None, png: Path | None, title: str, label: str, cmap: str,
