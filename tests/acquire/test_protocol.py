@@ -215,3 +215,27 @@ def test_homing_disabled_is_refused(cli, emulator, config_path, tmp_path):
             "-o", tmp_path / "h.h5")
     assert r.exit_code == 3 and "error:5 (homing not enabled)" in r.stderr
     assert not any(x.startswith("G1") for x in emu.grbl.log) and not (tmp_path / "h.h5").exists()
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"points": 300}, "VNA refused the settings: 2,\"INVALID NUMBER OF POINTS\""),
+    ({"if_bandwidth_hz": 500.0}, "INVALID IF BANDWIDTH"),
+    ({"power_dbm": 20.0}, "POWE? reads back 10, expected 20"),   # the analyzer clamps
+    ({"stop_hz": 7e9}, "STOP? reads back 6e+09, expected 7e+09"),
+])
+def test_vna_error_queue_and_readback(emulator, config_path, change, words):
+    """Settings the analyzer rejects (error queue) or changes (clamping) are caught by the driver
+    even when they bypass the configuration checks."""
+    from dataclasses import replace
+
+    from sarcli.gbsar.acquire.errors import InstrumentError
+
+    emu = emulator()
+    cfg = load_config(config_path)
+    inst = connect(cfg, emu.vna_port, emu.rail_port)
+    try:
+        with pytest.raises(InstrumentError, match=words.replace("?", r"\?").replace("+", r"\+")):
+            inst.vna.configure(replace(cfg.vna_settings(), **change))
+        assert inst.vna.errors() == []  # drained
+    finally:
+        inst.close()

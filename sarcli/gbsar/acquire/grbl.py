@@ -121,7 +121,7 @@ class GrblRail:
     def connect(self) -> str:
         """Soft-reset, wait for the ``Grbl 1.1x`` banner and check ``$I``; returns the version."""
         self.port.discard_input()
-        self.port.write(b"\x18")
+        self.soft_reset()
         deadline = time.monotonic() + self.boot_timeout_s
         while True:
             try:
