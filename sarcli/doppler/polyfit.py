@@ -63,11 +63,14 @@ def _norm(a: np.ndarray) -> tuple[float, float]:
 
 
 def fit_poly2d(x: np.ndarray, y: np.ndarray, z: np.ndarray, w: np.ndarray, degree: tuple[int, int] = (2, 1),
-               k_sigma: float = 4.0, floor: float = 0.0, max_iter: int = 10) -> tuple[Poly2D, np.ndarray]:
+               k_sigma: float = 4.0, floor: float = 0.0, max_iter: int = 10,
+               points_per_coef: int = 1) -> tuple[Poly2D, np.ndarray]:
     """Weighted LSQ fit with iterative outlier rejection. Returns (poly, outlier_flags).
 
-    Degrees are reduced automatically when there are too few distinct x or y values (one range block
-    -> degree 0 in range). Blocks with zero/NaN weight or NaN z are ignored (not flagged).
+    Degrees are reduced automatically so that every axis has at least ``points_per_coef`` distinct
+    coordinates per coefficient (noisy block estimates: 2, so 3 range blocks give a constant and
+    never an interpolating parabola that swings at the swath edges; noise-free model grids: 1).
+    Blocks with zero/NaN weight or NaN z are ignored (not flagged).
     """
     x = np.asarray(x, float).ravel()
     y = np.asarray(y, float).ravel()
@@ -76,8 +79,8 @@ def fit_poly2d(x: np.ndarray, y: np.ndarray, z: np.ndarray, w: np.ndarray, degre
     use = np.isfinite(z) & np.isfinite(w) & (w > 0)
     x0, xs = _norm(x)
     y0, ys = _norm(y)
-    dx = min(degree[0], max(len(np.unique(x[use])) - 1, 0))
-    dy = min(degree[1], max(len(np.unique(y[use])) - 1, 0))
+    dx = min(degree[0], max(len(np.unique(x[use])) // points_per_coef - 1, 0))
+    dy = min(degree[1], max(len(np.unique(y[use])) // points_per_coef - 1, 0))
     flags = np.zeros(z.shape, bool)
     if not np.any(use):
         return Poly2D(np.full((1, 1), np.nan), x0, xs, y0, ys), flags

@@ -1,0 +1,298 @@
+"""``estimate_doppler(raw) -> DopplerModel`` (contract 4): the seed's hybrid method, plus data-only routes.
+
+Pipeline
+1. Baseband centroid per (azimuth block, range block): CDE on the raw echo (default, the seed's
+   2048 x 128 blocks), SDE, or CDE after range compression ("rc-cde"); quality, SNR-aware validity,
+   inverse-variance weights (``cde``).
+2. Unwrap the baseband centroids over the block grid (``ambiguity.unwrap_blocks``).
+3. Ambiguity: from the orbit + attitude model (full vector form by default, or the closed form eq. 6),
+   one integer for the scene with its margin; the half-integer case is declared and, when possible,
+   broken by the data-only estimate. Without a usable orbit: MLCC + MLBF (``dataonly``) with their
+   confidence. ``ambiguity="none"`` keeps the baseband centroid (source "none", confidence 0).
+4. Absolute centroid per block, weighted 2-D polynomial fit in (slant range, azimuth time) with
+   outlier flags (``polyfit``).
+5. Doppler rate: exactly -(2/lam) d2R/deta2 at the target of the fitted absolute centroid (orbit),
+   also the seed's route (look angle re-solved from fdc) for comparison; without an orbit, map-drift
+   autofocus (``mapdrift``) per range segment.
+
+Block coordinates: slant range of the block's centre sample (raw sample k <-> two-way time
+window_start + k/fs; for the raw echo, energy at sample k comes from scatterers at that range, the
+pulse being centred on its delay) and the azimuth (pulse) time of its centre line.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sarcli.doppler import ambiguity as amb
+from sarcli.doppler.cde import block_correlation, check_finite, wrap_frequency
+from sarcli.doppler.dataonly import combine_estimates, mlbf, mlcc
+from sarcli.doppler.model import DopplerModel
+from sarcli.doppler.polyfit import Poly2D, fit_poly2d
+from sarcli.errors import SarcliError
+from sarcli.io.raw import RawProduct
+
+C = 299792458.0
+ESTIMATORS = ("cde", "sde", "rc-cde")
+AMBIGUITY_MODES = ("auto", "orbit", "data", "none")
+FR_METHODS = ("auto", "orbit", "seed", "mapdrift")
+FDC_MODELS = ("vector", "closed")
+
+
+def _has_orbit(raw: RawProduct) -> bool:
+    return raw.orbit is not None and raw.orbit.frame in ("ECI", "ECEF") and raw.orbit.time.size >= 2
+
+
+def _can_compress(raw: RawProduct) -> bool:
+    n_ref = raw.replica.size if raw.replica is not None and raw.replica.size > 1 else int(
+        round(raw.radar.pulse_length_s * raw.radar.range_sampling_rate_hz))
+    return raw.echo.shape[1] > n_ref + 16
+
+
+def _data_for(raw: RawProduct, estimator: str) -> tuple[np.ndarray, int]:
+    """(array to correlate, index of its first range sample in the raw echo)."""
+    if estimator != "rc-cde":
+        return raw.echo, 0
+    if not _can_compress(raw):
+        raise SarcliError("rc-cde needs a range extent longer than the pulse")
+    from sarcli.doppler.rangecomp import range_compress_valid
+
+    rc, valid = range_compress_valid(raw.echo, raw.radar, raw.replica)
+    return rc, valid.start
+
+
+def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 128, estimator: str = "cde",
+                     ambiguity: str = "auto", ambiguity_value: int | None = None, fr_method: str = "auto",
+                     fdc_model: str = "vector", fit_degree: tuple[int, int] = (2, 1),
+                     resid_degree: tuple[int, int] = (1, 1), model_degree: tuple[int, int] = (3, 2),
+                     n_nodes: int | None = None, exact_attitude: bool = True, height_m: float | None = None,
+                     half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
+                     min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
+                     mapdrift_segments: int = 4, dataonly_rg_block: int = 128) -> DopplerModel:
+    """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
+
+    ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
+    1-sigma error of the geometric centroid (default: Radarsat-1's 0.03 deg pitch knowledge, ~140 Hz);
+    it sets the orbit route's ambiguity confidence together with the block scatter.
+    """
+    for name, val, allowed in (("estimator", estimator, ESTIMATORS), ("ambiguity", ambiguity, AMBIGUITY_MODES),
+                               ("fr_method", fr_method, FR_METHODS), ("fdc_model", fdc_model, FDC_MODELS)):
+        if val not in allowed:
+            raise SarcliError(f"unknown {name} {val!r}; choose one of {', '.join(allowed)}")
+    if az_block < 2 or rg_block < 1:
+        raise SarcliError(f"block size must be at least 2 lines x 1 sample, got {az_block} x {rg_block}")
+    check_finite(raw.echo, "echo")
+    radar = raw.radar
+    prf, lam = radar.prf_hz, radar.wavelength_m
+    n_lines, n_samples = raw.echo.shape
+    if n_lines < 2:
+        raise SarcliError(f"the product has {n_lines} azimuth line(s); the Doppler estimate needs at least 2")
+    if height_m is None:
+        height_m = float(np.asarray(raw.truth.get("reference_height_m", 0.0))) if raw.truth else 0.0
+    params: dict[str, Any] = dict(az_block=az_block, rg_block=rg_block, estimator=estimator, ambiguity=ambiguity,
+                                  ambiguity_value=ambiguity_value, fr_method=fr_method, fdc_model=fdc_model,
+                                  fit_degree=list(fit_degree), resid_degree=list(resid_degree),
+                                  model_degree=list(model_degree), n_nodes=n_nodes, exact_attitude=exact_attitude,
+                                  height_m=height_m, half_tolerance=half_tolerance, orbit_sigma_hz=orbit_sigma_hz,
+                                  noise_sigmas=noise_sigmas, min_quality=min_quality, outlier_sigma=outlier_sigma,
+                                  velocity_guess_mps=velocity_guess_mps, mapdrift_segments=mapdrift_segments,
+                                  dataonly_rg_block=dataonly_rg_block)
+
+    # 1. baseband centroid per block
+    data, s_off = _data_for(raw, estimator)
+    bc = block_correlation(data, az_block, rg_block, "sde" if estimator == "sde" else "cde")
+    fbb = bc.baseband(prf)
+    q = bc.quality()
+    valid = bc.valid(noise_sigmas, min_quality)
+    w = bc.weight(noise_sigmas, min_quality)
+    lc, sc = bc.centres()
+    t_blk = np.interp(lc, np.arange(n_lines), raw.azimuth_time)
+    r_blk = radar.first_range_m + (sc + s_off) * C / (2.0 * radar.range_sampling_rate_hz)
+    T, Rg = np.meshgrid(t_blk, r_blk, indexing="ij")
+    if not np.any(valid):
+        raise SarcliError("no block has a usable Doppler signal (all blocks are noise or zero); "
+                          "try larger blocks (--az-block/--rg-block)")
+    sum_corr = np.sum(np.where(valid, bc.corr, 0))
+    if estimator == "sde":
+        sum_corr = np.sum(np.where(valid, bc.phase_rho() * bc.pairs, 0))
+    fbb_scene = float(wrap_frequency(prf * np.angle(sum_corr) / (2 * np.pi), prf))
+
+    # 2. unwrap
+    fu = amb.unwrap_blocks(np.where(valid, fbb, np.nan), w, prf, Rg, T)
+    fu = np.where(valid, fu, fbb_scene + wrap_frequency(fbb - fbb_scene, prf))
+
+    # 3. ambiguity
+    geo = None
+    if _has_orbit(raw):
+        from sarcli.doppler.geometry import OrbitGeometry
+
+        geo = OrbitGeometry.from_raw(raw, height_m, n_nodes, exact_attitude)
+    mode = ambiguity
+    if mode == "auto":
+        mode = "orbit" if geo is not None else ("data" if _can_compress(raw) else "none")
+    if mode == "orbit" and geo is None:
+        raise SarcliError("ambiguity from the orbit needs ECI/ECEF state vectors; use --ambiguity data")
+    if mode == "data" and not _can_compress(raw):
+        raise SarcliError("data-only ambiguity needs a range extent longer than the pulse")
+    summary: dict[str, Any] = {}
+    fdc_orbit = np.full(fbb.shape, np.nan)
+    data_only: list = []
+    if geo is not None:
+        fdc_orbit = geo.fdc_vector(Rg, T) if fdc_model == "vector" else geo.fdc_closed(Rg, T)
+
+    def run_data_only():
+        if not data_only and _can_compress(raw):
+            data_only.extend([mlcc(raw.echo, radar, fbb_scene, dataonly_rg_block, raw.replica),
+                              mlbf(raw.echo, radar, fbb_scene, dataonly_rg_block, raw.replica)])
+        return combine_estimates(data_only)
+
+    if ambiguity_value is not None:
+        res = amb.resolve(fbb, fu, fbb_scene + int(ambiguity_value) * prf, w, prf, half_tolerance)
+        source, conf = "user", 1.0
+    elif mode == "orbit":
+        res = amb.resolve(fbb, fu, fdc_orbit, w, prf, half_tolerance)
+        xi = (fdc_orbit - fu) / prf
+        ww = np.where(w > 0, w, 0)
+        scatter = np.sqrt(np.sum(ww * (xi - res.offset_prf) ** 2) / np.sum(ww))
+        sigma = np.hypot(orbit_sigma_hz / prf, scatter)
+        conf = amb.rounding_confidence(res.offset_prf, sigma)
+        source = "orbit"
+        if not res.resolved and _can_compress(raw):
+            n_d, c_d, _ = run_data_only()
+            n_lo, n_hi = int(np.floor(res.offset_prf)), int(np.ceil(res.offset_prf))
+            if n_d in (n_lo, n_hi) and c_d > 0:
+                res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, half_tolerance)
+                source, conf = "orbit+data", max(conf, c_d)
+    elif mode == "data":
+        n_d, conf, _ = run_data_only()
+        res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, half_tolerance)
+        source = "data"
+    else:
+        res = amb.resolve(fbb, fu, fbb_scene, w, prf, half_tolerance)
+        source, conf = "none", 0.0
+    fdc_abs = fbb + res.block_ambiguity * prf
+
+    # 4. 2-D fit with outlier flags. With an orbit the geometric model gives the SHAPE of the centroid
+    # over the scene (exact to < 0.001 Hz) and the data its offset: the blocks fit a low-order residual
+    # (data - model), and the model + residual is sampled on a dense grid and fitted by a higher-order
+    # polynomial (noise-free, fit error reported). Without an orbit the blocks are fitted directly.
+    GR, GT = _model_grid(raw)
+    fit_info: dict[str, Any] = {}
+    if geo is not None:
+        resid, outl = fit_poly2d(Rg, T, fdc_abs - fdc_orbit, w, resid_degree, k_sigma=outlier_sigma,
+                                 floor=0.002 * prf, points_per_coef=2)
+        g_orbit = geo.fdc_vector(GR, GT) if fdc_model == "vector" else geo.fdc_closed(GR, GT)
+        target = g_orbit + resid(GR, GT)
+        fdc_poly, _ = fit_poly2d(GR, GT, target, np.ones_like(GR), model_degree, k_sigma=np.inf)
+        fit_info["fdc_grid_fit_max_abs_hz"] = float(np.max(np.abs(fdc_poly(GR, GT) - target)))
+        fit_info["residual_coef_hz"] = resid.coef
+    else:
+        fdc_poly, outl = fit_poly2d(Rg, T, fdc_abs, w, fit_degree, k_sigma=outlier_sigma, floor=0.002 * prf,
+                                    points_per_coef=2)
+    outl = outl.reshape(fbb.shape)
+
+    # 5. Doppler rate
+    fr_blk, fr_seed, look_seed, rho_seed = (np.full(fbb.shape, np.nan) for _ in range(4))
+    fr_info: dict[str, Any] = {}
+    fdc_fit = fdc_poly(Rg, T)
+    fmethod = fr_method
+    if fmethod == "auto":
+        fmethod = "orbit" if geo is not None else ("mapdrift" if _can_compress(raw) else "nominal")
+    if fmethod in ("orbit", "seed") and geo is None:
+        raise SarcliError(f"fr method {fmethod!r} needs ECI/ECEF state vectors; use --fr-method mapdrift")
+    if geo is not None:
+        fr_seed, look_seed, rho_seed = geo.fr_seed(fdc_fit, Rg, T)
+        fr_exact = geo.fr_exact(Rg, T, fdc_fit)
+        fr_blk = fr_seed if fmethod == "seed" else fr_exact
+        fr_info["seed_vs_exact_max_rel"] = float(np.nanmax(np.abs(fr_seed / fr_exact - 1.0))) if np.any(
+            np.isfinite(fr_seed)) else None
+        fr_info["seed_domain_failures"] = int(np.count_nonzero(~np.isfinite(fr_seed)))
+        if fmethod in ("orbit", "seed"):
+            gf = geo.fr_exact(GR, GT, fdc_poly(GR, GT)) if fmethod == "orbit" else \
+                geo.fr_seed(fdc_poly(GR, GT), GR, GT)[0]
+            if not np.all(np.isfinite(gf)):
+                raise SarcliError("the seed's look-angle inversion left its asin/sqrt domain inside the scene; "
+                                  "use --fr-method orbit")
+            fr_poly, _ = fit_poly2d(GR, GT, gf, np.ones_like(gf), model_degree, k_sigma=np.inf)
+            fit_info["fr_grid_fit_max_rel"] = float(np.max(np.abs(fr_poly(GR, GT) / gf - 1.0)))
+    if fmethod == "mapdrift":
+        fr_poly, fr_blk, fr_info["mapdrift"] = _mapdrift(raw, fdc_poly, geo, Rg, T, velocity_guess_mps,
+                                                         mapdrift_segments)
+    elif fmethod == "nominal":
+        v = radar.platform_velocity_mps or velocity_guess_mps
+        fr_blk = -2.0 * v**2 / (lam * Rg)
+        fr_poly, _ = fit_poly2d(GR, GT, -2.0 * v**2 / (lam * GR), np.ones_like(GR), model_degree, k_sigma=np.inf)
+        fr_info["nominal_velocity_mps"] = v
+
+    r_c = radar.first_range_m + 0.5 * (n_samples - 1) * C / (2.0 * radar.range_sampling_rate_hz)
+    t_c = float(0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1]))
+    geo_cmp = {}
+    if geo is not None:
+        other = geo.fdc_closed(Rg, T) if fdc_model == "vector" else geo.fdc_vector(Rg, T)
+        geo_cmp["closed_minus_vector_max_abs_hz"] = float(np.max(np.abs(other - fdc_orbit)))
+        geo_cmp["fdc_data_minus_orbit_rms_hz"] = float(np.sqrt(np.average((fdc_abs - fdc_orbit) ** 2,
+                                                                          weights=np.where(w > 0, w, 0) + 1e-300)))
+    fdc_c = float(fdc_poly(r_c, t_c))
+    norm = np.sum(bc.energy[valid]) if estimator != "sde" else np.sum(bc.pairs[valid])
+    summary.update(
+        prf_hz=prf, fdc_baseband_hz=fbb_scene, quality=float(np.abs(sum_corr) / max(norm, 1e-300)),
+        ambiguity=int(np.rint((fdc_c - fbb_scene) / prf)), ambiguity_source=source,
+        ambiguity_confidence=float(conf), ambiguity_margin_prf=float(res.margin),
+        ambiguity_resolved=bool(res.resolved), fdc_hz=fdc_c, fr_hz_per_s=float(fr_poly(r_c, t_c)),
+        scene_range_m=float(r_c), scene_time_s=t_c, fdc_method=estimator,
+        fdc_model=fdc_model if geo else None, fr_method=fmethod, n_blocks=int(fbb.size),
+        n_az_blocks=int(fbb.shape[0]), n_rg_blocks=int(fbb.shape[1]), n_valid_blocks=int(valid.sum()),
+        n_outlier_blocks=int(outl.sum()), data_only=[e.as_dict() for e in data_only], fr_info=fr_info,
+        geometry=geo_cmp, fit=fit_info)
+    blocks = {
+        "range_m": Rg.ravel(), "azimuth_time_s": T.ravel(), "fdc_baseband_hz": fbb.ravel(), "quality": q.ravel(),
+        "weight": w.ravel(), "valid": valid.ravel(), "ambiguity": res.block_ambiguity.ravel(),
+        "margin_prf": res.block_margin.ravel(), "fdc_hz": fdc_abs.ravel(), "fdc_fit_hz": fdc_fit.ravel(),
+        "fdc_orbit_hz": fdc_orbit.ravel(), "fr_hz_per_s": np.asarray(fr_blk, float).ravel(),
+        "fr_seed_hz_per_s": fr_seed.ravel(), "look_seed_rad": look_seed.ravel(), "range_seed_m": rho_seed.ravel(),
+        "outlier": outl.ravel(),
+    }
+    return DopplerModel(fdc_poly, fr_poly, prf, lam, blocks, summary, params)
+
+
+def _model_grid(raw: RawProduct, n_r: int = 24, n_t: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Dense (time, range) grid over the whole scene on which the smooth models are sampled."""
+    r = raw.slant_range()
+    t = raw.azimuth_time
+    T, R = np.meshgrid(np.linspace(t[0], t[-1], n_t), np.linspace(r[0], r[-1], n_r), indexing="ij")
+    return R, T
+
+
+def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int):
+    """Map-drift rate per range segment over the whole azimuth extent; linear fit in range."""
+    from sarcli.doppler.mapdrift import map_drift
+    from sarcli.doppler.rangecomp import range_compress_valid
+
+    radar = raw.radar
+    rc, valid = range_compress_valid(raw.echo, radar, raw.replica)
+    dr = C / (2.0 * radar.range_sampling_rate_hz)
+    t_c = float(np.mean(raw.azimuth_time))
+    edges = np.linspace(0, rc.shape[1], max(1, n_seg) + 1).astype(int)
+    rng, frs, info = [], [], []
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        if b - a < 8:
+            continue
+        r_seg = radar.first_range_m + (valid.start + 0.5 * (a + b - 1)) * dr
+        fdc = float(fdc_poly(r_seg, t_c))
+        if geo is not None:
+            fr0 = float(geo.fr_exact(r_seg, t_c, fdc))
+        else:
+            v = radar.platform_velocity_mps or v_guess
+            fr0 = -2.0 * v**2 / (radar.wavelength_m * r_seg)
+        res = map_drift(rc[:, a:b], radar.prf_hz, radar.wavelength_m, r_seg, dr, fdc, fr0)
+        rng.append(r_seg)
+        frs.append(res.fr_hz_per_s)
+        info.append({"range_m": r_seg, "fr_hz_per_s": res.fr_hz_per_s, "start_hz_per_s": fr0,
+                     "iterations": res.iterations, "converged": res.converged})
+    if not frs:
+        raise SarcliError("map-drift: range extent too short after range compression")
+    rr = np.array(rng)
+    poly, _ = fit_poly2d(rr, np.full(rr.size, t_c), np.array(frs), np.ones(rr.size), (1, 0), k_sigma=np.inf)
+    return poly, poly(Rg, T), info

@@ -1,0 +1,197 @@
+"""Doppler centroid and rate from orbit + attitude (seed 002 eq. 4-6 and 9, corrected).
+
+Sign (project phase convention exp(-j*4*pi*R/lam), see ``orbit.geometry``):
+    fdc = -(2/lam) dR/deta = +(2/lam) v_rel . L,   fr = -(2/lam) d2R/deta2,
+with L the unit line of sight satellite -> target and v_rel the satellite velocity relative to the
+(Earth-fixed) target. The seed/digest's "-(2/lam) v_rel . L" has the opposite sign (typo).
+
+Full vector model (``fdc_vector``): at azimuth time eta, the target p is the point of the ellipsoid
+(+ height) at slant range rho in the beam-centre plane (p - r) . w = 0, w = Q R e_x the control
+frame's along-track axis (attitude pitch/yaw; flight frame Q from the ECI state, seed eq. 2-3:
+``orbit.geometry.target_from_look_plane``). p is then taken Earth-fixed and the Doppler is evaluated
+exactly in ECEF (``orbit.geometry.doppler_hz``).
+
+Closed form (``fdc_closed``, the seed's eq. 6 in our notation): with R Lc expanded to first order in
+pitch pp and yaw py, R Lc = (pp cos g - s py sin g, s sin g, cos g) (s = +1 right-looking), and
+v_rel approximated by the satellite-position form v - w_e x r (seed eq. 5), projected on the flight
+axes V_k = v_rel . {Xf, Yf, Zf}:
+
+    fdc(g) = A cos g + B sin g,   A = (2/lam) (V_z + pp V_x),   B = (2/lam) s (V_y - py V_x)     (eq. 6)
+
+where g is the look angle of the slant range in the cross-track plane. Its inversion for the seed's
+fr route (eq. 9 chain) is g = phi +- acos(fdc / C), C = sqrt(A^2 + B^2), phi = atan2(B, A) (equivalent
+to the printed g = asin(alpha f +- beta sqrt(alpha^2 + beta^2 - f^2)) with alpha = B/C^2, beta = A/C^2);
+the root in (0, pi/2) closest to the look angle of the block's slant range is kept; |fdc| > C (sqrt
+domain) or no root in (0, pi/2) (asin domain) is reported as NaN, never clipped silently. Then the
+spherical incidence i = asin(sin g (r + h)/r) and slant range rho = -r cos i + sqrt(r^2 cos^2 i + h^2
++ 2 r h) (seed, ``orbit.geometry.sphere_*``), and fr is evaluated exactly for the target at p = r + rho L(g)
+(the printed coefficients f_0, f_s, f_c, f_phi of eq. 9 contain typos and are not used).
+
+Exact rate (``fr_exact``): the target at slant range rho with the ABSOLUTE centroid fdc on the
+ellipsoid (``orbit.geometry.target_from_doppler``, ECEF) and fr = -(2/lam) d2R/deta2 from the
+Hermite-interpolated orbit (position, velocity AND acceleration, ``orbit.statevectors``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from orbit import geometry as og
+from orbit.constants import OMEGA_EARTH
+from orbit.errors import OrbitError
+from orbit.frames import eci_to_ecef
+from orbit.geodetic import ecef_to_geodetic
+from orbit.pointing import beam_vector, flight_frame, side_sign
+from orbit.statevectors import StateVectors
+from sarcli.errors import SarcliError
+from sarcli.io.raw import RawProduct
+
+
+@dataclass
+class OrbitGeometry:
+    """Orbit + attitude of a raw product, ready for Doppler evaluation at (slant range, azimuth time)."""
+
+    sv_eci: StateVectors
+    sv_ecef: StateVectors
+    att_time: np.ndarray
+    att_pitch: np.ndarray
+    att_yaw: np.ndarray
+    wavelength: float
+    side: str = "right"
+    height_m: float = 0.0
+    n_nodes: int | None = None
+    exact_attitude: bool = True
+
+    @classmethod
+    def from_raw(cls, raw: RawProduct, height_m: float = 0.0, n_nodes: int | None = None,
+                 exact_attitude: bool = True) -> OrbitGeometry:
+        o = raw.orbit
+        if o is None or o.frame not in ("ECI", "ECEF"):
+            raise SarcliError("the geometric Doppler model needs ECI or ECEF state vectors in /orbit")
+        try:
+            sv = StateVectors(o.time, o.position, o.velocity, o.frame, raw.epoch_utc)
+            sv_eci, sv_ecef = sv.to_eci(), sv.to_ecef()
+        except OrbitError as e:
+            raise SarcliError(f"orbit: {e}") from None
+        if raw.attitude is not None and np.size(raw.attitude.time) > 0:
+            a = raw.attitude
+            at, ap, ay = (np.atleast_1d(np.asarray(x, np.float64)) for x in (a.time, a.pitch, a.yaw))
+        else:
+            at, ap, ay = np.zeros(1), np.zeros(1), np.zeros(1)
+        return cls(sv_eci, sv_ecef, at, ap, ay, raw.radar.wavelength_m, raw.look_side, height_m, n_nodes,
+                   exact_attitude)
+
+    def attitude(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(pitch, yaw) rad at times t (linear interpolation, held constant outside the table)."""
+        if self.att_time.size == 1:
+            return np.full(np.shape(t), self.att_pitch[0]), np.full(np.shape(t), self.att_yaw[0])
+        return np.interp(t, self.att_time, self.att_pitch), np.interp(t, self.att_time, self.att_yaw)
+
+    def _states(self, t):
+        try:
+            r, v, _ = self.sv_eci.interpolate(t, self.n_nodes)
+            re, ve, ae = self.sv_ecef.interpolate(t, self.n_nodes)
+        except OrbitError as e:
+            raise SarcliError(f"orbit: {e}") from None
+        return r, v, re, ve, ae
+
+    def _to_ecef(self, t, p_eci):
+        return eci_to_ecef(self.sv_eci.epoch_utc, t, p_eci)
+
+    def fdc_vector(self, rho, t) -> np.ndarray:
+        """Full vector model: absolute fdc (Hz) of the beam-centre-plane target at (rho, t)."""
+        rho, t = np.broadcast_arrays(np.asarray(rho, np.float64), np.asarray(t, np.float64))
+        r, v, re, ve, _ = self._states(t)
+        pp, py = self.attitude(t)
+        try:
+            p = og.target_from_look_plane(r, v, rho, pp, py, self.side, self.height_m, self.exact_attitude)
+        except OrbitError as e:
+            raise SarcliError(f"geometry: {e}") from None
+        return og.doppler_hz(re, ve, self._to_ecef(t, p), self.wavelength)
+
+    def _closed_coeffs(self, r, v, pp, py):
+        q = flight_frame(r, v)
+        vrel = v - np.cross(np.array([0.0, 0.0, OMEGA_EARTH]), r)
+        vx, vy, vz = (np.einsum("...i,...i->...", vrel, q[..., :, k]) for k in range(3))
+        s = side_sign(self.side)
+        k = 2.0 / self.wavelength
+        return k * (vz + pp * vx), k * s * (vy - py * vx)
+
+    def _cross_track_look(self, r, v, rho):
+        try:
+            return og.look_from_slant_range(r, v, rho, self.side, self.height_m)
+        except OrbitError as e:
+            raise SarcliError(f"geometry: {e}") from None
+
+    def fdc_closed(self, rho, t) -> np.ndarray:
+        """Seed eq. 6 (corrected, module docstring): A cos g + B sin g, g from the slant range."""
+        rho, t = np.broadcast_arrays(np.asarray(rho, np.float64), np.asarray(t, np.float64))
+        r, v, _, _, _ = self._states(t)
+        pp, py = self.attitude(t)
+        A, B = self._closed_coeffs(r, v, pp, py)
+        g = self._cross_track_look(r, v, rho)
+        return A * np.cos(g) + B * np.sin(g)
+
+    def look_from_fdc(self, fdc, rho, t) -> np.ndarray:
+        """Seed inversion of eq. 6 for the look angle (rad); NaN outside the sqrt/asin domains."""
+        fdc, rho, t = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, rho, t)))
+        r, v, _, _, _ = self._states(t)
+        pp, py = self.attitude(t)
+        A, B = self._closed_coeffs(r, v, pp, py)
+        return invert_closed_form(fdc, A, B, self._cross_track_look(r, v, rho))
+
+    def fr_exact(self, rho, t, fdc) -> np.ndarray:
+        """-(2/lam) d2R/deta2 (Hz/s) of the target at slant range rho seen at absolute Doppler fdc."""
+        rho, t, fdc = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (rho, t, fdc)))
+        _, _, re, ve, ae = self._states(t)
+        try:
+            p = og.target_from_doppler(re, ve, rho, self.wavelength, fdc, self.side, self.height_m)
+        except OrbitError as e:
+            raise SarcliError(f"geometry: {e}") from None
+        return og.doppler_rate_hz_per_s(re, ve, ae, p, self.wavelength)
+
+    def fr_seed(self, fdc, rho, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Seed route: look angle re-solved from fdc (eq. 6 inverse), spherical incidence and slant
+        range, then the exact rate at that target. Returns (fr Hz/s, look rad, slant range m); NaN
+        where the inversion leaves its domain."""
+        fdc, rho, t = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, rho, t)))
+        r, v, re, ve, ae = self._states(t)
+        pp, py = self.attitude(t)
+        g = self.look_from_fdc(fdc, rho, t)
+        rs = np.linalg.norm(r, axis=-1)
+        h_sat = ecef_to_geodetic(re)[2]
+        re_local = rs - h_sat + self.height_m
+        out_fr = np.full(fdc.shape, np.nan)
+        out_rho = np.full(fdc.shape, np.nan)
+        ok = np.isfinite(g)
+        with np.errstate(invalid="ignore"):
+            s = np.sin(g) * rs / re_local
+        ok &= s < 1.0  # asin domain of the incidence
+        if np.any(ok):
+            inc = og.sphere_incidence_from_look(g[ok], re_local[ok], rs[ok])
+            rr = og.sphere_slant_range(inc, re_local[ok], rs[ok])
+            L = beam_vector(r[ok], v[ok], g[ok], pp[ok], py[ok], self.side, self.exact_attitude)
+            p = self._to_ecef(t[ok], r[ok] + rr[:, None] * L)
+            out_fr[ok] = og.doppler_rate_hz_per_s(re[ok], ve[ok], ae[ok], p, self.wavelength)
+            out_rho[ok] = rr
+        return out_fr, g, out_rho
+
+
+def invert_closed_form(fdc, A, B, look_hint) -> np.ndarray:
+    """Roots g of A cos g + B sin g = fdc in (0, pi/2), the one closest to ``look_hint``; NaN when
+    |fdc| > sqrt(A^2 + B^2) (the seed's sqrt domain) or no root lies in (0, pi/2) (its asin domain)."""
+    fdc, A, B, hint = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, A, B, look_hint)))
+    C = np.hypot(A, B)
+    phi = np.arctan2(B, A)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = fdc / C
+        d = np.where(np.abs(c) <= 1.0, np.arccos(np.clip(c, -1.0, 1.0)), np.nan)
+    best = np.full(fdc.shape, np.nan)
+    for sgn in (1.0, -1.0):
+        g = np.mod(phi + sgn * d + np.pi, 2 * np.pi) - np.pi
+        inside = (g > 0) & (g < np.pi / 2)
+        closer = ~np.isfinite(best) | (np.abs(g - hint) < np.abs(best - hint))
+        best = np.where(inside & closer, g, best)
+    return best

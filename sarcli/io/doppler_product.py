@@ -1,0 +1,100 @@
+"""The Doppler product ``doppler.h5`` (``product_type = "doppler"``), schema version 1.
+
+Layout (SI units)::
+
+    /                 provenance (sarcli.io.h5common; ``parameters`` = every estimation knob),
+                      prf_hz, wavelength_m, summary_json (the scene summary printed by --json),
+                      fdc_method, ambiguity_source, ambiguity_confidence, fr_method, n_az_blocks, n_rg_blocks
+    /blocks           one 1-D dataset per column, one row per (azimuth block, range block), row-major
+                      (azimuth outer): range_m, azimuth_time_s, fdc_baseband_hz, quality, weight, valid,
+                      ambiguity, margin_prf, fdc_hz (absolute, per block), fdc_fit_hz, fdc_orbit_hz,
+                      fr_hz_per_s, fr_seed_hz_per_s, look_seed_rad, range_seed_m, outlier
+    /fdc_poly         coef (dx+1, dy+1) Hz; attributes x0, xs (m), y0, ys (s):
+                      fdc(R, t) = sum coef[i, j] ((R - x0)/xs)^i ((t - y0)/ys)^j   (absolute centroid)
+    /fr_poly          the same for the Doppler rate (Hz/s)
+
+``read_doppler(path)`` returns the :class:`sarcli.doppler.model.DopplerModel` (contract 4).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from sarcli.doppler.model import DopplerModel
+from sarcli.doppler.polyfit import Poly2D
+from sarcli.errors import ProductError
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, provenance, require, to_jsonable
+
+PRODUCT_TYPE = "doppler"
+SCHEMA_VERSION = "1"
+
+UNITS = {"range_m": "m", "azimuth_time_s": "s", "fdc_baseband_hz": "Hz", "quality": "1", "weight": "rad^-2",
+         "valid": "1", "ambiguity": "1", "margin_prf": "1", "fdc_hz": "Hz", "fdc_fit_hz": "Hz",
+         "fdc_orbit_hz": "Hz", "fr_hz_per_s": "Hz/s", "fr_seed_hz_per_s": "Hz/s", "look_seed_rad": "rad",
+         "range_seed_m": "m", "outlier": "1"}
+
+
+def _write_poly(f, name: str, p: Poly2D, units: str) -> None:
+    g = group(f, name)
+    dataset(g, "coef", np.asarray(p.coef, np.float64), units=units,
+            description="sum coef[i,j] ((range - x0)/xs)^i ((time - y0)/ys)^j")
+    for k in ("x0", "xs", "y0", "ys"):
+        g.attrs[k] = float(getattr(p, k))
+
+
+def _read_poly(f, name: str, path) -> Poly2D:
+    if name not in f:
+        raise ProductError(f"{path}: malformed doppler product, missing '{name}'")
+    g = f[name]
+    coef = require(g, "coef", path, shape_rank=2)[()]
+    try:
+        return Poly2D(coef, *(float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys")))
+    except KeyError as e:
+        raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
+
+
+def write_doppler(path: str | os.PathLike, model: DopplerModel, inputs: tuple = ()) -> None:
+    """Write ``model`` atomically to ``path`` (block grid shape from ``model.summary``)."""
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, model.parameters, inputs) as f:
+        f.attrs["prf_hz"] = float(model.prf_hz)
+        f.attrs["wavelength_m"] = float(model.wavelength_m)
+        for k in ("n_az_blocks", "n_rg_blocks"):
+            f.attrs[k] = int(model.summary.get(k, 0))
+        f.attrs["summary_json"] = json.dumps(to_jsonable(model.summary), sort_keys=True)
+        for k in ("fdc_method", "ambiguity_source", "fr_method"):
+            f.attrs[k] = str(model.summary.get(k))
+        f.attrs["ambiguity_confidence"] = float(model.summary.get("ambiguity_confidence", 0.0))
+        g = group(f, "blocks")
+        for k in sorted(model.blocks):
+            v = np.asarray(model.blocks[k])
+            v = v.astype(np.int8) if v.dtype == bool else v
+            dataset(g, k, v, units=UNITS.get(k))
+        _write_poly(f, "fdc_poly", model.fdc_poly, "Hz")
+        _write_poly(f, "fr_poly", model.fr_poly, "Hz/s")
+
+
+def read_doppler(path: str | os.PathLike) -> DopplerModel:
+    """Read a ``doppler.h5`` into a :class:`DopplerModel`; a malformed file raises ProductError (one line)."""
+    with open_product(path, PRODUCT_TYPE) as f:
+        sv = attr_str(f, "schema_version")
+        if sv != SCHEMA_VERSION:
+            raise ProductError(f"{path}: doppler schema version {sv} is not supported (expected {SCHEMA_VERSION})")
+        for k in ("prf_hz", "wavelength_m"):
+            if k not in f.attrs:
+                raise ProductError(f"{path}: malformed doppler product, attribute '{k}' missing")
+        blocks = {}
+        if "blocks" in f:
+            for k in f["blocks"]:
+                v = f["blocks"][k][()]
+                blocks[k] = v.astype(bool) if k in ("valid", "outlier") else v
+        try:
+            summary = json.loads(attr_str(f, "summary_json") or "{}")
+        except json.JSONDecodeError:
+            raise ProductError(f"{path}: malformed doppler product, summary_json is not JSON") from None
+        params = provenance(f).get("parameters") or {}
+        return DopplerModel(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path),
+                            float(f.attrs["prf_hz"]), float(f.attrs["wavelength_m"]), blocks, summary,
+                            params if isinstance(params, dict) else {})
