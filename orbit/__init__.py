@@ -19,14 +19,24 @@ Public API (stable; other modules depend on it):
     ``hermite_reference(...)`` - plain-numpy reference of the kernel.
 ``orbit.frames``
     ``gmst(epoch, t)``, ``eci_to_ecef(epoch, t, r, v=None)``, ``ecef_to_eci(...)``.
+``orbit.precession``
+    ``j2000_to_eci`` / ``eci_to_j2000`` / ``tod_to_eci`` (IAU 1976/1980) for vectors not in the GMST frame.
 ``orbit.geodetic``
     ``ecef_to_geodetic(r) -> (lat_deg, lon_deg, h)``, ``geodetic_to_ecef(lat_deg, lon_deg, h)`` (pyproj).
 ``orbit.pointing``
-    flight frame (geodetic nadir), control rotation (exact / small-angle), look and beam vectors.
+    ``flight_frame(r, v)`` (geodetic nadir), ``control_rotation(pitch, yaw, exact=True)``,
+    ``beam_vector(r, v, look, pitch, yaw, side, exact)``, ``along_track_axis``, ``ellipsoid_normal``.
 ``orbit.geometry``
-    ellipsoid target solve, look <-> incidence <-> slant range, zero-/given-Doppler time, geolocation.
+    ``target_from_look`` (ray), ``target_from_doppler`` / ``target_from_look_plane`` / ``target_in_plane``
+    (range + plane + ellipsoid at height h, Newton), ``look_angle``, ``incidence_angle``,
+    ``incidence_from_look``, ``look_from_incidence``, ``slant_range_from_look``, ``look_from_slant_range``,
+    ``horizon_look_angle``, ``doppler_hz``, ``doppler_rate_hz_per_s``, ``relative_velocity_eci``,
+    ``doppler_from_attitude`` (seed's fdc_orbit), ``doppler_time(sv, p, lam, fdc, t_guess=...)``,
+    ``geolocate(sv, t, rho, lam, fdc, h, side)``, ``geolocate_geodetic``.
 ``orbit.propagate``
     ``Keplerian``, ``kepler_to_state``, ``propagate_j2`` (truth orbits for simulation and tests).
+``orbit.accuracy``
+    the accuracy/cost tables of ``sarcli orbit accuracy`` and ``bench/bench_orbit.py``.
 ``orbit.constants``, ``orbit.timeutil``, ``orbit.errors``.
 
 Doppler sign: with the phase convention exp(-j*4*pi*R/lam), f_D = -(2/lam) dR/dt

@@ -125,11 +125,11 @@ def target_from_look(r, v, look, side: str = "right", pitch=0.0, yaw=0.0, h=0.0,
 
 
 def _plane_solve(r, n_hat, alpha, rho, e1, e2, dh) -> np.ndarray:
-    """Angle beta of u = alpha n + k (cos b e1 + sin b e2) with r + rho u on ellipsoid (a+dh, b+dh).
+    """Point r + rho u, u = alpha n + k (cos b e1 + sin b e2), k = sqrt(1 - alpha^2), on the ellipsoid (a+dh, b+dh).
 
     Newton on g(b) = G(r + rho u(b)), G = (x^2+y^2)/A^2 + z^2/B^2 - 1, safeguarded by the bracket
     [0, pi/2] (g < 0 at the nadir-most direction, g > 0 horizontally) with bisection when a Newton step
-    leaves it. Returns beta; raises if the root is the far (exit) intersection or does not converge.
+    leaves it. Raises if the root is the far (exit) intersection or the iteration does not converge.
     """
     A = WGS84_A + dh
     B = WGS84_B + dh
@@ -180,7 +180,7 @@ def _plane_solve(r, n_hat, alpha, rho, e1, e2, dh) -> np.ndarray:
         raise GeometryError(
             f"slant range up to {np.max(rho):.3f} m reaches beyond the horizon (the solution would be on the "
             "far side of the Earth)")
-    return beta
+    return p
 
 
 def target_in_plane(r, n, c, rho, side: str = "right", h=0.0) -> np.ndarray:
@@ -212,14 +212,9 @@ def target_in_plane(r, n, c, rho, side: str = "right", h=0.0) -> np.ndarray:
     e1 = down - _dot(down, n_hat)[..., None] * n_hat
     e1 = e1 / _norm(e1)[..., None]
     e2 = side_sign(side) * np.cross(e1, n_hat)
-    k = np.sqrt(1.0 - alpha**2)
 
-    def solve(dh):
-        beta = _plane_solve(r, n_hat, alpha, rho, e1, e2, np.broadcast_to(dh, shape))
-        return r + rho[..., None] * (alpha[..., None] * n_hat
-                                     + k[..., None] * (np.cos(beta)[..., None] * e1 + np.sin(beta)[..., None] * e2))
-
-    return _on_height_surface(solve, np.broadcast_to(np.asarray(h, np.float64), shape))
+    return _on_height_surface(lambda dh: _plane_solve(r, n_hat, alpha, rho, e1, e2, np.broadcast_to(dh, shape)),
+                              np.broadcast_to(np.asarray(h, np.float64), shape))
 
 
 def target_from_doppler(r, v, rho, wavelength: float, fdc=0.0, side: str = "right", h=0.0) -> np.ndarray:

@@ -12,14 +12,14 @@ from sarcli.io.raw import Orbit, Radar, RawProduct, write_raw
 from tests.orbit.conftest import EPOCH, SPACING
 
 
-def _product(path, truth, frame="ECI", orbit=True, t_shift=3000.0):
+def _product(path, truth, frame="ECI", orbit=True, t_shift=3000.0, extra=None):
     sv = truth.sv
     radar = Radar(carrier_frequency_hz=5.3e9, wavelength_m=0.05656, prf_hz=1256.98, range_sampling_rate_hz=32.317e6,
                   chirp_rate_hz_per_s=-7.2135e11, pulse_length_s=41.74e-6, window_start_s=6.5956e-3,
                   first_range_m=988_647.46)
     o = Orbit(sv.time, sv.position, sv.velocity, frame) if orbit else None
     raw = RawProduct(echo=np.zeros((16, 24), np.complex64), azimuth_time=t_shift + np.arange(16) / 1256.98,
-                     epoch_utc=EPOCH, radar=radar, orbit=o)
+                     epoch_utc=EPOCH, radar=radar, orbit=o, extra_attrs=extra or {})
     write_raw(path, raw)
     return path
 
@@ -107,3 +107,11 @@ def test_accuracy_table_and_plot(cli, tmp_path):
     assert by_n[2]["pos_err_interior_m"] > by_n[4]["pos_err_interior_m"] > by_n[6]["pos_err_interior_m"]
     assert [a["scale"] for a in d["attitude"]] == [0.0, 1.0, 10.0, 100.0]
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_info_reports_the_ceos_hour_angle_check(cli, tmp_path, polar_truth):
+    p = _product(tmp_path / "gha.h5", polar_truth, extra={"ceos_gha_minus_gmst_deg": 0.001})
+    r = cli("orbit", "info", p, "--json")
+    s = json.loads(r.stdout)
+    assert s["gha_minus_gmst_deg"] == 0.001 and s["gha_minus_gmst_ground_m"] == pytest.approx(111.3, abs=0.1)
+    assert "frame check" in cli("orbit", "info", p).stderr

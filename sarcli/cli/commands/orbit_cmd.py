@@ -96,7 +96,8 @@ def info_cmd(
     Reports whether every azimuth line lies inside the state-vector span (interpolation refuses times
     outside it), the spacing (non-uniform spacing is fine), the default Hermite order, and for ECI/ECEF
     orbits the altitude, pass direction, and the zero-Doppler look and incidence angles of the first
-    (and last) range sample at the scene centre.
+    (and last) range sample at the scene centre. For ingested CEOS products, the difference between
+    the delivered Greenwich hour angle and sarcli's GMST shows which equinox the vectors use.
 
     Examples:
 
@@ -106,6 +107,7 @@ def info_cmd(
     """
     import numpy as np
 
+    from orbit.constants import WGS84_A
     from orbit.timeutil import add_seconds
     from sarcli.io.raw import raw_shape
 
@@ -125,6 +127,10 @@ def info_cmd(
     }
     if sv.frame != "LOCAL":
         s["geometry"] = _scene_geometry(raw, sv, raw_shape(raw_path)[1])
+    gha = _gha_minus_gmst_deg(raw_path)
+    if gha is not None:  # CEOS products: the delivered hour angle tells which equinox the vectors use
+        s["gha_minus_gmst_deg"] = gha
+        s["gha_minus_gmst_ground_m"] = abs(np.radians(gha)) * WGS84_A
     if as_json:
         emit_json(s)
         return
@@ -145,6 +151,18 @@ def info_cmd(
             zip(g["zero_doppler_slant_range_m"], g["look_angle_deg"], g["incidence_angle_deg"], strict=True)))
     if "geometry_note" in g:
         info(f"  geometry: {g['geometry_note']}")
+    if "gha_minus_gmst_deg" in s:
+        info(f"  frame check: product hour angle - GMST = {s['gha_minus_gmst_deg']:.6f} deg "
+             f"({s['gha_minus_gmst_ground_m']:.1f} m at the equator)")
+
+
+def _gha_minus_gmst_deg(path: Path) -> float | None:
+    """The CEOS reader's ``ceos_gha_minus_gmst_deg`` root attribute, if the product has one."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        v = f.attrs.get("ceos_gha_minus_gmst_deg")
+    return None if v is None else float(v)
 
 
 @orbit_app.command("interpolate")
