@@ -15,7 +15,10 @@ i (closest range ``R0_i``, effective velocity ``V_i``, centroid ``fdc_i``) and b
    spectrum of a chirp with negative rate carries (C&W's filter omits it: their peaks are off by
    pi/4, which matters for interferometry and for RD vs backprojection), and
    ``exp(-j 2 pi f_bin shift / PRF)`` moves the focused target ``shift`` lines later (an integer,
-   so the wrapped and absolute frequencies give the same phase).
+   so the wrapped and absolute frequencies give the same phase), and ``exp(-j 2 pi f dt_i)`` moves it
+   by the (fractional) time ``dt_i`` (s) with the ABSOLUTE frequency, which keeps the carrier phase:
+   the orbit correction of the hyperbolic model's zero-Doppler time (:mod:`sarcli.focus.rda`);
+   ``exp(j ph0_i)`` is the matching constant phase correction (its closest range).
 
 ``D - 1`` is computed as ``-x / (1 + D)`` (x = (lam f / 2V)^2) so the 1e5-rad phase keeps full float64
 precision. The kernel runs in the precision of ``S``/``out`` (complex64 or complex128) with float64
@@ -32,7 +35,7 @@ from sarcli.focus.windows import window
 
 
 @njit(parallel=True, cache=True)
-def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, wavelength, prf, ba, wtab, kind, table, shift, out):
+def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba, wtab, kind, table, shift, out):
     """Fused RCMC + azimuth matched filter; writes ``out`` (n_az, len(r0)); ``out`` may be ``s``."""
     na, nr = s.shape
     nout = r0.shape[0]
@@ -81,11 +84,12 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, wavelength, prf, ba, wtab, k
                         m = n - k0 + q
                         if 0 <= m < nr:
                             val += row[m] * table[jp, q]
-            ph = 4.0 * np.pi * r0[i] * dm1 / wavelength + psh + 0.25 * np.pi
+            ph = 4.0 * np.pi * r0[i] * dm1 / wavelength + psh + 0.25 * np.pi - 2.0 * np.pi * f * dt[i] + ph0[i]
             out[k, i] = val * w * complex(np.cos(ph), np.sin(ph))
 
 
-def rcmc_azimuth_numpy(s, f_bin, r_first, dr, r0, v, fdc, wavelength, prf, ba, window_spec, interpolator, shift):
+def rcmc_azimuth_numpy(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba, window_spec, interpolator,
+                       shift):
     """Plain-numpy reference of :func:`rcmc_azimuth` (exact window and interpolation weights)."""
     off = f_bin[:, None] - fdc[None, :]
     off = off - prf * np.floor(off / prf + 0.5)
@@ -95,5 +99,5 @@ def rcmc_azimuth_numpy(s, f_bin, r_first, dr, r0, v, fdc, wavelength, prf, ba, w
     p = (r0[None, :] / d - r_first) / dr
     val = interpolate_numpy(s, p, interpolator)
     ph = (4.0 * np.pi * r0[None, :] * (d - 1.0) / wavelength - 2.0 * np.pi * f_bin[:, None] * shift / prf
-          + 0.25 * np.pi)
+          + 0.25 * np.pi - 2.0 * np.pi * f * dt[None, :] + ph0[None, :])
     return val * w * np.exp(1j * ph)

@@ -33,7 +33,7 @@ import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require, to_jsonable
 from sarcli.io.raw import Attitude, Orbit, Radar
 
 PRODUCT_TYPE = "slc"
@@ -73,6 +73,20 @@ class SLC:
     attitude: Attitude | None = None
     truth: dict[str, Any] | None = None
 
+    @classmethod
+    def placeholder(cls, raw, shape: tuple[int, int]) -> SLC:
+        """An empty SLC for :func:`slc_writer` to fill while streaming (see :meth:`update_from`)."""
+        e = np.zeros(0)
+        return cls(image=np.zeros((0, 0), np.complex64), azimuth_time=np.zeros(shape[0]),
+                   slant_range=np.zeros(shape[1]), epoch_utc=raw.epoch_utc, radar=raw.radar,
+                   doppler=DopplerUsed(e, e, e, e, e))
+
+    def update_from(self, other: SLC) -> None:
+        """Take every field of ``other`` except the image (metadata known after streaming)."""
+        for f in dataclasses.fields(self):
+            if f.name != "image":
+                setattr(self, f.name, getattr(other, f.name))
+
     @property
     def prf_hz(self) -> float:
         return float(1.0 / np.median(np.diff(self.azimuth_time))) if self.azimuth_time.size > 1 else self.radar.prf_hz
@@ -83,6 +97,7 @@ class SLC:
 
 
 def _write_meta(f: h5py.File, s: SLC) -> None:
+    f.attrs["parameters"] = json.dumps(to_jsonable(dict(s.parameters)), sort_keys=True)
     f.attrs["epoch_utc"] = s.epoch_utc
     f.attrs["look_side"] = s.look_side
     f.attrs["source"] = s.source
@@ -138,8 +153,8 @@ def slc_writer(path: str | os.PathLike, meta: SLC, shape: tuple[int, int], input
     """Create the product atomically and yield the empty ``/image`` dataset to fill block by block.
 
     ``meta`` carries everything but the image (its ``image`` may be empty); metadata that is only
-    known after processing (timings, Doppler) can be updated on ``meta`` inside the block: it is
-    written when the block exits.
+    known after processing (axes, Doppler, timings, parameters) can be set on ``meta`` inside the
+    block (:meth:`SLC.update_from`): it is written when the block exits.
     """
     chunks = (min(shape[0], 256), min(shape[1], 2048))
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, meta.parameters, inputs) as f:

@@ -1,0 +1,158 @@
+"""Amplitude GeoTIFFs of an SLC: slant-range geometry with a lat/lon GCP grid, and map-projected (UTM).
+
+Geolocation of a pixel (line time t = zero-Doppler time, column = slant range R) is the zero-Doppler
+target at height h (the truth's reference height for simulated scenes, else 0):
+:func:`sarcli.focus.geolocation.zero_doppler_points` (orbit.geometry, WGS-84).
+
+- Slant-range GeoTIFF: the (multilooked) amplitude as it is, with a ``gcp_lines x gcp_cols`` grid of
+  ground control points (pixel centres, EPSG:4326 lon/lat/h).
+- Map-projected GeoTIFF: UTM zone of the scene centre (EPSG:326zz north / 327zz south) unless a CRS is
+  given. A coarse grid (``coarse`` x ``coarse`` nodes) is geolocated and projected; the inverse map
+  (x, y) -> (line, column) is linear over its Delaunay triangles (the map is smooth: the error of the
+  linear pieces is below 0.01 pixel for a Radarsat-1 swath), and the intensity is resampled
+  bilinearly (sqrt after resampling), NaN outside the image. Pixel spacing: the larger of the ground
+  range and azimuth spacings of the looks (no aliasing) unless given. Written in row strips.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sarcli.errors import SarcliError
+from sarcli.io.slc import SLC
+
+
+def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
+    """Mean intensity |z|^2 over looks_az x looks_rg cells (float32; partial cells at the end dropped)."""
+    if looks_az < 1 or looks_rg < 1:
+        raise SarcliError("looks must be positive integers")
+    n, m = image.shape[0] // looks_az, image.shape[1] // looks_rg
+    if n < 1 or m < 1:
+        raise SarcliError(f"image {image.shape} is smaller than one {looks_az} x {looks_rg} look cell")
+    out = np.empty((n, m), np.float32)
+    step = max(1, 4096 // looks_az)
+    for a in range(0, n, step):
+        b = min(n, a + step)
+        blk = image[a * looks_az:b * looks_az, :m * looks_rg]
+        p = (blk.real.astype(np.float32) ** 2 + blk.imag.astype(np.float32) ** 2)
+        out[a:b] = p.reshape(b - a, looks_az, m, looks_rg).mean(axis=(1, 3))
+    return out
+
+
+def reference_height(slc: SLC) -> float:
+    if slc.truth is not None and "reference_height_m" in slc.truth:
+        return float(np.asarray(slc.truth["reference_height_m"]))
+    return 0.0
+
+
+def _look_axes(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int]):
+    """Zero-Doppler time and slant range at the centres of the look cells."""
+    t = slc.azimuth_time[: shape[0] * looks_az].reshape(shape[0], looks_az).mean(axis=1)
+    r = slc.slant_range[: shape[1] * looks_rg].reshape(shape[1], looks_rg).mean(axis=1)
+    return t, r
+
+
+def geolocate_grid(slc: SLC, rows: np.ndarray, cols: np.ndarray, t: np.ndarray, r: np.ndarray,
+                   height: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lat_deg, lon_deg, h) at the grid rows x cols of axes t (lines) and r (columns)."""
+    from orbit.geodetic import ecef_to_geodetic
+    from sarcli.focus.geolocation import zero_doppler_points
+
+    if slc.orbit is None or slc.orbit.frame == "LOCAL":
+        raise SarcliError("GeoTIFF needs an Earth orbit (ECI/ECEF state vectors); this product has "
+                          f"{'none' if slc.orbit is None else 'a LOCAL (flat) frame'}")
+    tt, rr = np.meshgrid(t[rows], r[cols], indexing="ij")
+    p = zero_doppler_points(slc.orbit, slc.epoch_utc, tt, rr, slc.radar.wavelength_m, slc.look_side, height)
+    return ecef_to_geodetic(p)
+
+
+def _grid_index(n: int, k: int) -> np.ndarray:
+    return np.unique(np.round(np.linspace(0, n - 1, max(2, min(k, n)))).astype(int))
+
+
+def slant_gcps(slc: SLC, shape: tuple[int, int], looks_az: int, looks_rg: int, gcp_lines: int = 10,
+               gcp_cols: int = 10) -> list[tuple[float, float, float, float, float]]:
+    """GCPs (row, col, lon, lat, h) at pixel centres of the multilooked raster."""
+    t, r = _look_axes(slc, looks_az, looks_rg, shape)
+    rows, cols = _grid_index(shape[0], gcp_lines), _grid_index(shape[1], gcp_cols)
+    lat, lon, h = geolocate_grid(slc, rows, cols, t, r, reference_height(slc))
+    return [(rows[i] + 0.5, cols[j] + 0.5, float(lon[i, j]), float(lat[i, j]), float(h[i, j]))
+            for i in range(rows.size) for j in range(cols.size)]
+
+
+def utm_epsg(lat_deg: float, lon_deg: float) -> int:
+    """EPSG code of the UTM zone (WGS-84) containing (lat, lon)."""
+    zone = int(np.floor((lon_deg + 180.0) / 6.0)) % 60 + 1
+    return (32600 if lat_deg >= 0 else 32700) + zone
+
+
+def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None) -> None:
+    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326)."""
+    from sarcli.io.images import write_geotiff
+
+    inten = multilook(slc.image, looks_az, looks_rg)
+    gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg)
+    write_geotiff(path, np.sqrt(inten), 4326, gcps=gcps, tags=tags,
+                  band_description="amplitude, slant-range geometry (lines: zero-Doppler time)")
+
+
+def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
+                spacing_m: float | None = None, coarse: int = 33, strip: int = 512):
+    """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection."""
+    from pyproj import Transformer
+    from rasterio.transform import Affine
+    from scipy.interpolate import LinearNDInterpolator
+    from scipy.ndimage import map_coordinates
+
+    inten = multilook(slc.image, looks_az, looks_rg)
+    n, m = inten.shape
+    t, r = _look_axes(slc, looks_az, looks_rg, inten.shape)
+    rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
+    lat, lon, _ = geolocate_grid(slc, rows, cols, t, r, reference_height(slc))
+    if crs is None:
+        crs = f"EPSG:{utm_epsg(float(np.mean(lat)), float(np.mean(lon)))}"
+    try:
+        tr = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
+        x, y = tr.transform(lon, lat)
+    except Exception as e:  # pyproj raises several types for bad CRS strings
+        raise SarcliError(f"cannot project to {crs}: {e}") from None
+    x, y = np.asarray(x), np.asarray(y)
+    if spacing_m is None:
+        d_az = np.hypot(np.diff(x, axis=0), np.diff(y, axis=0)) / np.diff(rows)[:, None]
+        d_rg = np.hypot(np.diff(x, axis=1), np.diff(y, axis=1)) / np.diff(cols)[None, :]
+        spacing_m = float(max(np.median(d_az), np.median(d_rg)))
+    if not spacing_m > 0:
+        raise SarcliError(f"pixel spacing must be positive, got {spacing_m}")
+    x0, x1, y0, y1 = x.min(), x.max(), y.min(), y.max()
+    nx = int(np.ceil((x1 - x0) / spacing_m)) + 1
+    ny = int(np.ceil((y1 - y0) / spacing_m)) + 1
+    if nx * ny > 4e9 / 4:
+        raise SarcliError(f"map raster {ny} x {nx} is too large: increase the pixel spacing or the looks")
+    rr, cc = np.meshgrid(rows.astype(float), cols.astype(float), indexing="ij")
+    inv = LinearNDInterpolator(np.column_stack([x.ravel(), y.ravel()]), np.column_stack([rr.ravel(), cc.ravel()]))
+    out = np.full((ny, nx), np.nan, np.float32)
+    xs = x0 + np.arange(nx) * spacing_m
+    for a in range(0, ny, strip):
+        b = min(ny, a + strip)
+        ys = y1 - np.arange(a, b) * spacing_m
+        gx, gy = np.meshgrid(xs, ys)
+        rc = inv(gx.ravel(), gy.ravel())
+        ok = np.all(np.isfinite(rc), axis=1)
+        vals = np.full(gx.size, np.nan, np.float32)
+        if np.any(ok):
+            vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
+        out[a:b] = np.sqrt(vals).reshape(gx.shape)
+    # pixel (i, j) centre at (x0 + j s, y1 - i s): the raster's corner is half a pixel up-left of it
+    transform = Affine(spacing_m, 0.0, x0 - 0.5 * spacing_m, 0.0, -spacing_m, y1 + 0.5 * spacing_m)
+    return out, transform, crs
+
+
+def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
+                      spacing_m: float | None = None, tags: dict | None = None) -> str:
+    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used."""
+    from sarcli.io.images import write_geotiff
+
+    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m)
+    write_geotiff(path, amp, crs, transform=transform, tags=tags,
+                  band_description="amplitude, map projected (bilinear intensity resampling)")
+    return crs
