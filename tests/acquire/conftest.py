@@ -50,7 +50,8 @@ if_bandwidth_hz = 1000
 data_format = "FORM2"
 read_timeout_ms = 40
 opc_read_timeout_ms = 100
-data_timeout_s = 0.3
+read_margin_s = 0.08
+data_timeout_s = 0.15
 retries = 3
 
 [rail]

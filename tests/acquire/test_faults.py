@@ -99,7 +99,7 @@ def test_sweep_deadline(cli, emulator, config_path, tmp_path):
     """A sweep that never completes within its deadline (OPC? silent) ends the scan cleanly."""
     emu = emulator(faults="slow-sweep@3:60")
     out = tmp_path / "f.h5"
-    # SWET = 201 * (1/IFBW + 0.6 ms); deadline = 1.5 SWET + 4 OPC polls of 0.1 + 0.25 s ~ 1.6 s at 6 kHz
+    # SWET = 201 * (1/IFBW + 0.6 ms); deadline = 1.5 SWET + 4 OPC polls of 0.1 + 0.08 s ~ 0.9 s at 6 kHz
     r = cli(*scan_args(emu, config_path, "-o", out, "--ifbw", "6000"))
     assert r.exit_code == 3 and "OPC? never answered" in r.stderr
     assert read_scan(out).n_stops == 1

@@ -9,6 +9,7 @@ rail travel within ``[0, max_travel_m]``. Units are SI (Hz, m, s, dBm); angles i
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
@@ -40,6 +41,7 @@ class VnaConfig:
     gpib_address: int = 16
     max_frequency_hz: float = vna.MAX_FREQUENCY_OPT006_HZ  # 3e9 without option 006
     read_timeout_ms: int = 500      # Prologix ++read_tmo_ms
+    read_margin_s: float = 0.25     # host waits ++read_tmo_ms + this for the first byte (USB latency)
     data_timeout_s: float = 5.0     # extra time allowed for a whole data block
     opc_read_timeout_ms: int = 3000  # ++read_tmo_ms while waiting for OPC? after SING (<= 3000)
     retries: int = 3
@@ -176,6 +178,8 @@ def validate(cfg: ScanConfig, max_frequency_hz: float | None = None, max_travel_
         raise ConfigError("GPIB addresses must be 0..30")
     if not (1 <= v.read_timeout_ms <= 3000 and 1 <= v.opc_read_timeout_ms <= 3000):
         raise ConfigError("vna.read_timeout_ms and opc_read_timeout_ms must be 1..3000 (Prologix limit)")
+    if v.read_margin_s < 0:
+        raise ConfigError("vna.read_margin_s must be >= 0")
     if v.retries < 0 or r.retries < 0:
         raise ConfigError("retries must be >= 0")
     pols = p.polarizations
@@ -243,7 +247,6 @@ _TIME_UNITS = {"": 1.0, "s": 1.0, "m": 60.0, "min": 60.0, "h": 3600.0, "d": 8640
 
 
 def _quantity(text: str, units: dict[str, float], what: str) -> float:
-    import re
     parts = re.findall(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Z]*)", text.strip())
     joined = "".join(f"{n}{u}" for n, u in parts).replace(" ", "")
     if not parts or joined != text.strip().replace(" ", "") or any(u.lower() not in units for _, u in parts):

@@ -50,7 +50,7 @@ def connect(cfg: ScanConfig, vna_port: str, rail_port: str,
         ports.append(vp)
         rp = Port(rail_port, "rail", stop_requested=stop_requested)
         ports.append(rp)
-        gpib = Prologix(vp, cfg.vna.gpib_address, cfg.vna.read_timeout_ms, cfg.vna.retries)
+        gpib = Prologix(vp, cfg.vna.gpib_address, cfg.vna.read_timeout_ms, cfg.vna.retries, cfg.vna.read_margin_s)
         ident: dict[str, Any] = {"prologix_version": gpib.init()}
         vna = Prologix8753(gpib, cfg.vna.gpib_address, cfg.vna.retries, cfg.vna.data_timeout_s,
                            cfg.vna.opc_read_timeout_ms)

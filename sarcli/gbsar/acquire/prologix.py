@@ -17,7 +17,7 @@ from sarcli.gbsar.acquire.port import Port
 
 ESC = 0x1B
 _SPECIAL = frozenset(b"\r\n\x1b+")
-#: margin (s) added to the adapter's own read timeout before the host gives up on a ``++read``
+#: default margin (s) added to the adapter's own read timeout before the host gives up on a ``++read``
 READ_MARGIN_S = 0.25
 
 
@@ -70,10 +70,12 @@ def unescape_split(stream: bytes) -> tuple[list[tuple[bytes, bool]], bytes]:
 class Prologix:
     """The adapter in controller mode, ``++auto 0``, EOI on, LF appended to instrument data."""
 
-    def __init__(self, port: Port, address: int = 16, read_tmo_ms: int = 500, retries: int = 3):
+    def __init__(self, port: Port, address: int = 16, read_tmo_ms: int = 500, retries: int = 3,
+                 read_margin_s: float = READ_MARGIN_S):
         if not 1 <= read_tmo_ms <= 3000:
             raise InstrumentError(f"Prologix read timeout must be 1..3000 ms, got {read_tmo_ms}")
         self.port, self.read_tmo_ms, self.retries = port, int(read_tmo_ms), int(retries)
+        self.read_margin_s = float(read_margin_s)
         self.home_address = int(address)
         self.address: int | None = None
         self.version = ""
@@ -81,7 +83,7 @@ class Prologix:
     @property
     def read_window_s(self) -> float:
         """How long the host waits for the first byte after ``++read``."""
-        return self.read_tmo_ms / 1000.0 + READ_MARGIN_S
+        return self.read_tmo_ms / 1000.0 + self.read_margin_s
 
     def adapter(self, command: str) -> None:
         """Send one ``++`` command (no escaping: it is for the adapter)."""

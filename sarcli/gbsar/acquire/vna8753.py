@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarcli.gbsar.acquire.errors import GarbledData, InstrumentError, InstrumentTimeout
-from sarcli.gbsar.acquire.prologix import READ_MARGIN_S, Prologix
+from sarcli.gbsar.acquire.prologix import Prologix
 
 ALLOWED_POINTS = (3, 11, 26, 51, 101, 201, 401, 801, 1601)
 ALLOWED_IFBW_HZ = (10, 30, 100, 300, 1000, 3000, 3700, 6000)
@@ -68,7 +68,7 @@ class Prologix8753:
         self.data_timeout_s = float(data_timeout_s)
         self.opc_read_tmo_ms = int(opc_read_tmo_ms)
         # sweep deadline: 1.5 x SWET + 4 OPC polls
-        self.sweep_margin_s = 4 * (opc_read_tmo_ms / 1000.0 + READ_MARGIN_S)
+        self.sweep_margin_s = 4 * (opc_read_tmo_ms / 1000.0 + gpib.read_margin_s)
         self.settings: VnaSettings | None = None
         self.sweep_time_s = 0.0
         self.retry_count = 0  # recoveries so far (reported in the scan file)
