@@ -63,7 +63,8 @@ def test_interpolate_at_nodes_returns_the_vectors(cli, product, polar_truth, tmp
 
 
 @pytest.mark.parametrize("args,match", [
-    (["--times", "7300"], "outside the state-vector span"),
+    (["--times", "7300"], "outside the state-vector span [0.000000, 6720.000000] s (use --extrapolate"),
+    (["--times", "7300", "--extrapolate", "100"], "+ 100 s allowed extrapolation"),
     (["--times", "abc"], "cannot read 'abc'"),
     (["--times", "5:1:1"], "cannot read"),
     (["--times", "0", "--frame", "j2000"], "--frame must be"),

@@ -192,6 +192,7 @@ def interpolate_cmd(
     """
     import numpy as np
 
+    from orbit.errors import InterpolationRangeError
     from orbit.geodetic import ecef_to_geodetic
     from orbit.timeutil import add_seconds
 
@@ -204,7 +205,11 @@ def interpolate_cmd(
     elif frame == "eci":
         sv = sv.to_eci()
     t = np.array(parse_times(times))
-    p, v, a = sv.interpolate(t, n_nodes, max_extrapolation_s=extrapolate)
+    try:
+        p, v, a = sv.interpolate(t, n_nodes, max_extrapolation_s=extrapolate)
+    except InterpolationRangeError as e:
+        raise SarcliError(str(e).split(" (pass ")[0] + (" (use --extrapolate SECONDS to allow a bounded "
+                                                         "extrapolation)" if not extrapolate else "")) from None
     cols = {"time_s": t, "x_m": p[:, 0], "y_m": p[:, 1], "z_m": p[:, 2], "vx_mps": v[:, 0], "vy_mps": v[:, 1],
             "vz_mps": v[:, 2], "ax_mps2": a[:, 0], "ay_mps2": a[:, 1], "az_mps2": a[:, 2]}
     if sv.frame == "ECEF":
