@@ -125,11 +125,18 @@ def atomic_h5(
             f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; a product gets the usual mode
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def _command_line() -> str:

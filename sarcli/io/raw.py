@@ -43,7 +43,7 @@ import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.h5common import PROVENANCE_ATTRS, atomic_h5, attr_str, dataset, group, open_product, require
 
 PRODUCT_TYPE = "raw"
 SCHEMA_VERSION = "1"
@@ -278,6 +278,9 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
             replica=g["replica"][()] if "replica" in g else None,
             orbit=orbit, attitude=attitude, truth=truth,
         )
+        standard = set(PROVENANCE_ATTRS) | {"epoch_utc", "look_side", "source", "n_channels"}
+        p.extra_attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()
+                         if k not in standard}
         if not p.epoch_utc:
             raise ProductError(f"{path}: malformed product, epoch_utc missing")
         if load_echo:

@@ -162,3 +162,20 @@ def test_provenance_inputs_hash(tmp_path):
         inputs = json.loads(f.attrs["inputs"])
     assert inputs == [{"path": "in.bin",
                        "sha256": "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"}]
+
+
+def test_products_get_the_usual_file_mode(tmp_path):
+    import os
+    import stat
+
+    write_raw(tmp_path / "r.h5", _raw())
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE((tmp_path / "r.h5").stat().st_mode) == 0o666 & ~mask
+
+
+def test_extra_root_attributes_round_trip(tmp_path):
+    p = _raw()
+    p.extra_attrs = {"ceos_beam": "F1", "published_fdc_hz": -6900.0}
+    write_raw(tmp_path / "r.h5", p)
+    assert read_raw(tmp_path / "r.h5").extra_attrs == {"ceos_beam": "F1", "published_fdc_hz": -6900.0}
