@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sarcli.ati.detect import Candidate, CfarKnobs, detect
+from sarcli.ati.detect import Candidate, CfarKnobs, bistatic_phase, detect
 from sarcli.ati.estimate import Estimate, SlowTime, estimate
 from sarcli.ati.geometry import Mover, Platform, coefficients, range_history, stationary_history
 from sarcli.ati.slowtime import choose_bin, coregister, decompress, peak_range, recompress, track_peak
@@ -133,8 +133,11 @@ def slow_time(pair: Pair, c: Candidate, bin_mode: str = "track") -> tuple[SlowTi
     rows, cols = _window(pair, c)
     s0 = decompress(pair.slc0, pair.z0, rows, cols)
     s1 = decompress(pair.slc0, pair.z1, rows, cols)
-    n0 = choose_bin(s0)
+    # range bin from the clutter-cancelled (DPCA) signal: stationary scatterers in the window also
+    # have a constant slow-time amplitude (small ANV), but cancel in s1 - s0*exp(j*phi_c)
     ranges = np.asarray(pair.slc0.slant_range)[cols]
+    phi_c = bistatic_phase(ranges, pair.baseline_m, pair.platform.wavelength)
+    n0 = choose_bin(s1 - s0 * np.exp(1j * phi_c)[None, :])
     r_min, r_sd = peak_range(s0, ranges)
     if bin_mode == "track":
         a0, a1 = track_peak(s0, n0), track_peak(s1, n0)
@@ -253,15 +256,11 @@ def width_3db(cut: np.ndarray, row: int) -> float:
     return float(right - left)
 
 
-def centroid_row(cut: np.ndarray, row: int, floor_db: float = -20.0) -> float:
-    """Intensity-weighted centre (fractional row) of the contiguous region around ``row`` above
-    ``floor_db`` relative to its peak: where a smeared mover's energy sits."""
-    p = np.abs(cut) ** 2
-    thr = p[row] * 10.0 ** (floor_db / 10.0)
-    lo, hi = row, row
-    while lo > 0 and p[lo - 1] > thr:
-        lo -= 1
-    while hi < p.size - 1 and p[hi + 1] > thr:
-        hi += 1
-    idx = np.arange(lo, hi + 1)
-    return float(np.sum(idx * p[lo:hi + 1]) / np.sum(p[lo:hi + 1]))
+def centroid_row(image: np.ndarray, rows: slice, cols: slice, floor_db: float = -20.0) -> float:
+    """Intensity-weighted centre row (fractional, image coordinates) of the pixels of
+    ``image[rows, cols]`` within ``floor_db`` of its peak: where a smeared mover's energy sits
+    (its smear also bends across range columns, so a single-column cut would be biased)."""
+    p = np.abs(image[rows, cols]).astype(np.float64) ** 2
+    p[p < p.max() * 10.0 ** (floor_db / 10.0)] = 0.0
+    idx = np.arange(rows.start, rows.start + p.shape[0])
+    return float(np.sum(idx[:, None] * p) / np.sum(p))

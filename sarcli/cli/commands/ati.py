@@ -200,7 +200,7 @@ def compensate_cmd(
                "peak_range_m": float(pair.slc0.slant_range[c]), "width_3db_m": width_3db(cut, r) * dt * vp,
                "before_peak_y_local_m": y_of(peak_position(cut_b, rb)),
                "before_width_3db_m": width_3db(cut_b, rb) * dt * vp,
-               "before_centroid_y_local_m": y_of(centroid_row(cut_b, rb)),
+               "before_centroid_y_local_m": y_of(centroid_row(pair.z0, res.rows, res.cols)),
                "estimated_y_local_m": d["y_local_m"]}
         if compare_conventional:
             conv = compensate(pair, res, "conventional")
