@@ -49,17 +49,22 @@ class TruthOrbit:
     v: np.ndarray
 
 
+def truth_orbit(elements: Keplerian, node_times, dense_times, epoch_utc: str = RS1_EPOCH) -> TruthOrbit:
+    """Propagate ``elements`` (at t = 0) with J2 to the node and dense times: ECI vectors + reference."""
+    tn = np.asarray(node_times, np.float64)
+    td = np.asarray(dense_times, np.float64)
+    r0, v0 = kepler_to_state(elements)
+    r, v = propagate_j2(r0, v0, np.concatenate([tn, td]))
+    return TruthOrbit(StateVectors(tn, r[:tn.size], v[:tn.size], "ECI", epoch_utc), td, r[tn.size:], v[tn.size:])
+
+
 def rs1_truth(spacing_s: float = 480.0, n_vectors: int = 15, dense_step_s: float = 2.0,
               jitter_s: float = 0.0, seed: int = 0) -> TruthOrbit:
     """Radarsat-1-like truth orbit (a = 7167 km, e = 0.0011, i = 98.6 deg); optional node time jitter."""
     tn = np.arange(n_vectors) * spacing_s
     if jitter_s:
         tn = tn + np.random.default_rng(seed).uniform(-jitter_s, jitter_s, n_vectors)
-    td = np.arange(tn[0], tn[-1], dense_step_s)
-    r0, v0 = kepler_to_state(RS1_ELEMENTS)
-    r, v = propagate_j2(r0, v0, np.concatenate([tn, td]))
-    return TruthOrbit(StateVectors(tn, r[:n_vectors], v[:n_vectors], "ECI", RS1_EPOCH), td,
-                      r[n_vectors:], v[n_vectors:])
+    return truth_orbit(RS1_ELEMENTS, tn, np.arange(tn[0], tn[-1], dense_step_s))
 
 
 def _zones(truth: TruthOrbit) -> dict[str, np.ndarray]:

@@ -26,7 +26,14 @@ import numpy as np
 from orbit.constants import OMEGA_EARTH, WGS84_A, WGS84_B
 from orbit.errors import GeometryError
 from orbit.geodetic import ecef_to_geodetic
-from orbit.pointing import along_track_axis, beam_vector, ellipsoid_normal, flight_frame, side_sign
+from orbit.pointing import (
+    along_track_axis,
+    beam_vector,
+    ellipsoid_normal,
+    flight_frame,
+    look_vector_control,
+    side_sign,
+)
 from orbit.statevectors import StateVectors
 
 _HEIGHT_TOL_M = 1e-4
@@ -96,11 +103,13 @@ def _ray_ellipsoid(r, L, dh) -> np.ndarray:
 def horizon_look_angle(r, v, side: str = "right", h=0.0) -> np.ndarray:
     """Largest look angle (rad, from geodetic nadir, zero pitch/yaw) that still hits the surface of height h."""
     r = np.asarray(r, np.float64)
+    Q = flight_frame(r, v)
     lo = np.zeros(r.shape[:-1])
     hi = np.full(r.shape[:-1], np.pi / 2)
     for _ in range(60):  # bisection to ~1e-18 rad on [0, pi/2]
         mid = 0.5 * (lo + hi)
-        hit = np.isfinite(_ray_ellipsoid(r, beam_vector(r, v, mid, side=side), np.asarray(h, np.float64)))
+        L = np.einsum("...ij,...j->...i", Q, look_vector_control(mid, side))
+        hit = np.isfinite(_ray_ellipsoid(r, L, np.asarray(h, np.float64)))
         lo = np.where(hit, mid, lo)
         hi = np.where(hit, hi, mid)
     return lo

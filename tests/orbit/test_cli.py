@@ -9,7 +9,7 @@ import pytest
 
 from orbit.frames import eci_to_ecef
 from sarcli.io.raw import Orbit, Radar, RawProduct, write_raw
-from tests.orbit.conftest import EPOCH, SPACING
+from tests.orbit.truth import EPOCH, SPACING
 
 
 def _product(path, truth, frame="ECI", orbit=True, t_shift=3000.0, extra=None):

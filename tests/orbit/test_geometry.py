@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from orbit import geometry as G
 from orbit.errors import GeometryError
@@ -11,7 +13,7 @@ from orbit.frames import eci_to_ecef, gmst
 from orbit.geodetic import ecef_to_geodetic
 from orbit.pointing import beam_vector, flight_frame
 from orbit.statevectors import StateVectors
-from tests.orbit.conftest import EPOCH, make_truth
+from tests.orbit.truth import EPOCH, make_truth
 
 LAM = 0.05656  # Radarsat-1 wavelength, m
 RS1_PITCH, RS1_YAW = np.radians(0.03), np.radians(0.004)
@@ -221,3 +223,24 @@ def test_doppler_from_attitude_is_the_beam_doppler(polar_truth, scale):
     assert np.abs(got - expect).max() < 1e-6
     if scale == 0:  # zero attitude in ECI: only the Earth rotation's Doppler remains (kHz at C band)
         assert np.all(np.abs(got) > 100.0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(0.0, 6720.0), st.floats(0.2, 1.0), st.floats(-5000.0, 5000.0), st.floats(-300.0, 8000.0),
+       st.sampled_from(["right", "left"]))
+def test_property_geolocation_constraints_and_inverse(t, look, fdc, h, side):
+    """Any time, look (11-57 deg), Doppler and height: the geolocated point has that range, Doppler and
+    height, lies on the requested side, and its Doppler time is t again."""
+    sv = _PROP_SV
+    r, v, _ = sv.interpolate(t)
+    rho = float(G.slant_range_from_look(r, v, look, side, h))
+    p = G.geolocate(sv, t, rho, LAM, fdc, h, side)
+    assert abs(np.linalg.norm(p - r) - rho) < 1e-6
+    assert abs(G.doppler_hz(r, v, p, LAM) - fdc) < 1e-6
+    assert abs(ecef_to_geodetic(p)[2] - h) < 1e-4
+    assert np.sign((p - r) @ flight_frame(r, v)[:, 1]) == (1 if side == "right" else -1)
+    t2, rho2 = G.doppler_time(sv, p, LAM, fdc, t_guess=t)
+    assert abs(t2 - t) < 1e-6 and abs(rho2 - rho) < 1e-3
+
+
+_PROP_SV = make_truth(98.6, n_dense=2).sv.to_ecef()

@@ -10,7 +10,7 @@ from scipy.interpolate import KroghInterpolator
 
 from orbit.errors import InterpolationRangeError, OrbitError, StateVectorError
 from orbit.statevectors import DEFAULT_N_NODES, StateVectors, hermite_reference
-from tests.orbit.conftest import EPOCH, SPACING, make_truth
+from tests.orbit.truth import EPOCH, SPACING, make_truth
 
 
 def _err(a, b):
