@@ -43,7 +43,8 @@ def clean(tmp_path_factory):
 # event counts: sweeps and OUTPDATA answers are 2 per stop (HH, VV); moves 1 per stop
 RECOVERABLE = [("vna-timeout@5", "FORM2"), ("garble@6", "FORM2"), ("truncate@7", "FORM2"),
                ("slow-sweep@4:0.3", "FORM2"), ("grbl-error@3", "FORM2"), ("stall@4", "FORM2"),
-               ("status-garble@9", "FORM2"), ("garble@2,truncate@3,vna-timeout@4,grbl-error@2", "FORM2"),
+               ("status-garble@9", "FORM2"), ("lost-ok@4", "FORM2"),
+               ("garble@2,truncate@3,vna-timeout@4,grbl-error@2", "FORM2"),
                ("garble@6", "FORM4"), ("truncate@7", "FORM4"), ("vna-timeout@3", "FORM4")]
 
 

@@ -119,7 +119,7 @@ def emulate_cmd(
     scene: Path = typer.Option(None, "--scene", help="GB-SAR scene TOML whose S21 the VNA measures "
                                "(default: a calibrated thru, S21 = 1)."),
     faults: str = typer.Option("", "--faults", help="Faults NAME@N[:ARG],... (vna-timeout garble truncate "
-                               "slow-sweep vna-unplug grbl-error alarm stall status-garble rail-unplug)."),
+                               "slow-sweep vna-unplug grbl-error alarm stall lost-ok status-garble rail-unplug)."),
     time_scale: float = typer.Option(1.0, "--time-scale", help="Sweep/move duration factor (0 = instant)."),
     switch: str = typer.Option("none", "--switch", help="Emulated polarization switch: none, grbl, 11713a."),
     pol: str = typer.Option("VV", "--pol", help="The fixed polarization when --switch none."),

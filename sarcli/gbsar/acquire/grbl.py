@@ -180,27 +180,43 @@ class GrblRail:
         return self.settings.get(130, 200.0)
 
     def move_to(self, x_mm: float, feed_mm_min: float) -> Status:
-        """Absolute move to ``x_mm`` and wait until it is finished and confirmed by MPos."""
+        """Absolute move to ``x_mm`` and wait until it is finished and confirmed by MPos.
+
+        A lost ``ok`` for the move line is not fatal: the ``G4`` dwell and the read-back decide
+        whether the move was taken (a move that was not is sent again, it is absolute).
+        """
         feed = min(feed_mm_min, self.max_rate_mm_min)
         self.in_motion = True
         for attempt in range(self.retries + 1):
             start = self.status().x_mm
             duration = move_time(x_mm - start, feed / 60.0, self.accel_mm_s2)
+            deadline = time.monotonic() + 2.0 * duration + self.timeout_s
             try:
-                self.command(f"G1 X{x_mm:.3f} F{feed:.0f}")
+                try:
+                    self.command(f"G1 X{x_mm:.3f} F{feed:.0f}")
+                except InstrumentTimeout:
+                    self.retry_count += 1
                 self.command("G4 P0.01", timeout_s=2.0 * duration + self.timeout_s)
             except GrblError as e:
                 if attempt == self.retries or e.code in (9, 33):  # locked / impossible: do not insist
                     raise
                 self.retry_count += 1
                 continue
-            st = self.status()
+            st = self.wait_idle(deadline)
             if st.state == "Idle" and abs(st.x_mm - x_mm) <= POSITION_TOLERANCE_MM:
                 self.in_motion = False
                 return st
             self.retry_count += 1
         raise InstrumentError(
             f"rail: move to X{x_mm:.3f} mm not confirmed (state {st.state}, MPos X{st.x_mm:.3f})")
+
+    def wait_idle(self, deadline: float, poll_s: float = 0.05) -> Status:
+        """Status reports until the axis is no longer running (or the deadline)."""
+        while True:
+            st = self.status()
+            if st.state not in ("Run", "Jog", "Home") or time.monotonic() > deadline:
+                return st
+            time.sleep(poll_s)
 
 
 def _code(text: str) -> int:

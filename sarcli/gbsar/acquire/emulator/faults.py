@@ -14,6 +14,7 @@ name                 counted event               effect
 ``alarm``            rail moves                  ``ALARM:ARG`` (default 1, hard limit) half way,
                                                  then ``[MSG:Reset to continue]``; only 0x18 served
 ``stall``            rail moves                  the axis stops half way, state Idle
+``lost-ok``          rail moves                  the move is executed but its ``ok`` never sent
 ``status-garble``    status reports (``?``)      the report is cut short
 ``rail-unplug``      rail moves                  the rail port closes mid-move
 ===================  ==========================  ================================================
@@ -29,7 +30,7 @@ from sarcli.errors import SarcliError
 FAULTS = {
     "vna-timeout": "data", "garble": "data", "truncate": "data",
     "slow-sweep": "sweep", "vna-unplug": "sweep",
-    "grbl-error": "move", "alarm": "move", "stall": "move", "rail-unplug": "move",
+    "grbl-error": "move", "alarm": "move", "stall": "move", "rail-unplug": "move", "lost-ok": "move",
     "status-garble": "status",
 }
 DEFAULT_ARG = {"slow-sweep": 4.0, "grbl-error": 2.0, "alarm": 1.0}

@@ -218,7 +218,8 @@ class EmulatedGrbl(PtyDevice):
             target = x0 + 0.5 * (target - x0)
         self.move = (x0, target, self.now, min(feed, s[110]) / 60.0, s[120])
         self.state = "Run"
-        self._ok()
+        if "lost-ok" not in due:
+            self._ok()
         self.tick()
 
     def _dollar(self, line: str) -> None:
