@@ -85,6 +85,33 @@ def _sinc2(x):
     return s * s
 
 
+@njit(cache=True, inline="always")
+def _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, p):
+    """(d, R_tx, gain) of target i seen from pulse k; d = p_k - r_k returned in p."""
+    _target_at(rot, k, tp, tv, i, t[k] - tref[i], p)
+    p[0] -= rp[k, 0]
+    p[1] -= rp[k, 1]
+    p[2] -= rp[k, 2]
+    rtx = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    g = 1.0
+    if pattern:
+        sa = (p[0] * ux[k, 0] + p[1] * ux[k, 1] + p[2] * ux[k, 2]) / rtx
+        se = (p[0] * ue[k, 0] + p[1] * ue[k, 1] + p[2] * ue[k, 2]) / rtx
+        g = _sinc2(laz * sa) * _sinc2(lel * se)
+    return rtx, g
+
+
+@njit(cache=True, inline="always")
+def _channel_range(d, rtx, off, ux, k):
+    """Bistatic mean range (R_tx + R_rx)/2 for a receiver ``off`` metres along the antenna axis."""
+    if off == 0.0:
+        return rtx
+    e0 = d[0] - off * ux[k, 0]
+    e1 = d[1] - off * ux[k, 1]
+    e2 = d[2] - off * ux[k, 2]
+    return 0.5 * (rtx + math.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
+
+
 @njit(cache=True, parallel=True)
 def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
                 migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
@@ -98,46 +125,55 @@ def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, 
     for b in prange(n_blocks):
         a0 = b * block
         a1 = min(n_lines, a0 + block)
-        p = np.empty(3)
+        d = np.empty(3)
         for i in range(n_t):
-            lo = max(k0[i], a0)
-            hi = min(k1[i], a1)
-            for k in range(lo, hi):
-                _target_at(rot, k, tp, tv, i, t[k] - tref[i], p)
-                d0 = p[0] - rp[k, 0]
-                d1 = p[1] - rp[k, 1]
-                d2 = p[2] - rp[k, 2]
-                rtx = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-                g = 1.0
-                if pattern:
-                    sa = (d0 * ux[k, 0] + d1 * ux[k, 1] + d2 * ux[k, 2]) / rtx
-                    se = (d0 * ue[k, 0] + d1 * ue[k, 1] + d2 * ue[k, 2]) / rtx
-                    g = _sinc2(laz * sa) * _sinc2(lel * se)
+            for k in range(max(k0[i], a0), min(k1[i], a1)):
+                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, d)
                 for c in range(n_ch):
-                    off = rx_off[c]
-                    rc = rtx
-                    if off != 0.0:
-                        e0 = d0 - off * ux[k, 0]
-                        e1 = d1 - off * ux[k, 1]
-                        e2 = d2 - off * ux[k, 2]
-                        rc = 0.5 * (rtx + math.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
-                    renv = rc if migrate else r0[i]
-                    td = 2.0 * renv / C
+                    rc = _channel_range(d, rtx, rx_off[c], ux, k)
+                    td = 2.0 * (rc if migrate else r0[i]) / C
                     n_lo = max(0, math.ceil((td - 0.5 * plen - ws) * fs))
                     n_hi = min(n_s - 1, math.floor((td + 0.5 * plen - ws) * fs))
                     if n_hi < n_lo:
                         continue
                     ph = -4.0 * math.pi * rc / lam
-                    z0 = amp[i] * g * complex(math.cos(ph), math.sin(ph))
                     tau = ws + n_lo * dts - td
                     a = math.pi * kr * tau * tau
-                    z = z0 * complex(math.cos(a), math.sin(a))
+                    z = amp[i] * g * complex(math.cos(ph + a), math.sin(ph + a))
                     wa = math.pi * kr * (2.0 * tau * dts + dts * dts)
                     w = complex(math.cos(wa), math.sin(wa))
                     for n in range(n_lo, n_hi + 1):
                         out[c, k, n] += z
                         z *= w
                         w *= ww
+
+
+@njit(cache=True, parallel=True)
+def splat_kernel(grid, line0, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
+                 migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
+    """Binned clutter: add a_i G exp(-j 4 pi R_c/lam) at fractional delay bin x = 2 R_env/c * fq - x0 of
+    grid (n_channels, lines line0.., L), split linearly between the two neighbouring bins."""
+    n_ch, n_lines, n_l = grid.shape
+    n_t = tp.shape[0]
+    n_blocks = (n_lines + block - 1) // block
+    for b in prange(n_blocks):
+        a0 = line0 + b * block
+        a1 = min(line0 + n_lines, a0 + block)
+        d = np.empty(3)
+        for i in range(n_t):
+            for k in range(max(k0[i], a0), min(k1[i], a1)):
+                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, d)
+                for c in range(n_ch):
+                    rc = _channel_range(d, rtx, rx_off[c], ux, k)
+                    x = 2.0 * (rc if migrate else r0[i]) / C * fq - x0
+                    j = math.floor(x)
+                    if j < 0 or j + 1 >= n_l:
+                        continue
+                    f = x - j
+                    ph = -4.0 * math.pi * rc / lam
+                    z = amp[i] * g * complex(math.cos(ph), math.sin(ph))
+                    grid[c, k - line0, j] += z * (1.0 - f)
+                    grid[c, k - line0, j + 1] += z * f
 
 
 def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,

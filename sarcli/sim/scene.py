@@ -216,6 +216,8 @@ class Scene:
     targets: list[PointTarget] = field(default_factory=list)
     clutter: list[ClutterPatch] = field(default_factory=list)
     reference_height_m: float = 0.0
+    clutter_model: str = "binned"
+    clutter_oversampling: int = 8
 
     def has(self, effect: str) -> bool:
         return effect in self.effects
@@ -347,6 +349,8 @@ def parse_scene(text: str, src: str = "<scene>") -> Scene:
         raise st.err("epoch_utc", str(e)) from None
     center = st.num("center_time_s", 0.0)
     ref_h = st.num("reference_height_m", 0.0)
+    clutter_model = st.str("clutter_model", "binned", ("binned", "exact"))
+    clutter_q = st.int("clutter_oversampling", 8, minimum=2)
     st.used.add("effects")
     effects = st.data.get("effects", [])
     if not isinstance(effects, list) or not all(isinstance(x, str) for x in effects):
@@ -367,7 +371,8 @@ def parse_scene(text: str, src: str = "<scene>") -> Scene:
     root.finish()
     return Scene(path=src, source_text=text, name=name, seed=seed, epoch_utc=epoch, center_time_s=center,
                  effects=tuple(effects), effect_params=params, radar=radar, antenna=antenna,
-                 platform=platform, targets=targets, clutter=clutter, reference_height_m=ref_h)
+                 platform=platform, targets=targets, clutter=clutter, reference_height_m=ref_h,
+                 clutter_model=clutter_model, clutter_oversampling=clutter_q)
 
 
 def _list(root: _Table, key: str) -> list:

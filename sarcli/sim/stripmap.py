@@ -11,6 +11,7 @@ import numpy as np
 from numba import get_num_threads
 
 from sarcli.io.raw import Attitude, Radar, RawProduct
+from sarcli.sim.binned import BLOCK_LINES, add_binned_echo
 from sarcli.sim.context import SimContext
 from sarcli.sim.effects import apply_all, configure_all
 from sarcli.sim.geometry import Motion, closest_approach
@@ -27,6 +28,14 @@ N_ATTITUDE_RECORDS = 64
 def _concat(a: TargetSet, b: TargetSet) -> TargetSet:
     return TargetSet(np.concatenate([a.q, b.q]), np.concatenate([a.u, b.u]),
                      np.concatenate([a.t_ref, b.t_ref]), np.concatenate([a.amp, b.amp]))
+
+
+def _by_range(ts: TargetSet, traj: Trajectory, motion: Motion) -> TargetSet:
+    """Targets sorted by their range at the scene centre (neighbours write neighbouring grid bins: cache)."""
+    p, _, _ = motion.state(ts.q, ts.u, ts.t_ref, np.zeros(len(ts)))
+    r, _, _ = traj.state(np.zeros(1))
+    o = np.argsort(np.linalg.norm(p - r, axis=-1), kind="stable")
+    return TargetSet(ts.q[o], ts.u[o], ts.t_ref[o], ts.amp[o])
 
 
 def prepare(scene: Scene):
@@ -68,10 +77,12 @@ def simulate(scene: Scene, dtype=np.complex64) -> RawProduct:
     rad = scene.radar
     n_ch = len(ctx.receiver_offsets_m)
     out = np.zeros((n_ch, rad.n_lines, rad.n_samples), dtype)
-    all_targets = _concat(points, clutter)
-    args = kernel_args(scene, ctx, traj, motion, axes, rot, all_targets)
     block = max(8, rad.n_lines // (4 * get_num_threads()))
-    echo_kernel(out, *args, block)
+    exact = _concat(points, clutter) if scene.clutter_model == "exact" else points
+    echo_kernel(out, *kernel_args(scene, ctx, traj, motion, axes, rot, exact), block)
+    if scene.clutter_model == "binned" and len(clutter):
+        bargs = kernel_args(scene, ctx, traj, motion, axes, rot, _by_range(clutter, traj, motion))
+        add_binned_echo(out, bargs, rad, scene.clutter_oversampling, max(8, BLOCK_LINES // (4 * get_num_threads())))
 
     tc = scene.center_time_s
     ux, _, ub, pitch_total = axes
