@@ -37,6 +37,7 @@ from orbit.pointing import (
 from orbit.statevectors import StateVectors
 
 _HEIGHT_TOL_M = 1e-4
+_NADIR_TOL = 1e-12  # |G| below this at the nadir-most direction (~6 um) counts as a nadir solution
 _MAX_HEIGHT_ITER = 8
 
 
@@ -159,7 +160,7 @@ def _plane_solve(r, n_hat, alpha, rho, e1, e2, dh) -> np.ndarray:
     hi = np.full(rho.shape, np.pi / 2)
     g_lo, _ = g_and_slope(lo)
     g_hi, _ = g_and_slope(hi)
-    if np.any(g_lo >= 0) or np.any(g_hi <= 0):
+    if np.any(g_lo > _NADIR_TOL) or np.any(g_hi <= 0):
         raise GeometryError(
             f"no target on the Earth at slant range {np.min(rho):.3f}..{np.max(rho):.3f} m from this "
             "position: the range is shorter than the distance to the surface or the Doppler/look plane "
@@ -169,7 +170,7 @@ def _plane_solve(r, n_hat, alpha, rho, e1, e2, dh) -> np.ndarray:
     re = rs - ecef_to_geodetic(r)[2] + dh
     rho_in = rho * k
     cosb = np.clip((rs**2 + rho_in**2 - re**2) / (2.0 * rs * rho_in), -1.0, 1.0)
-    beta = np.clip(np.arccos(cosb), 0.0, np.pi / 2)
+    beta = np.where(g_lo >= 0, 0.0, np.clip(np.arccos(cosb), 0.0, np.pi / 2))  # g_lo ~ 0: the nadir itself
     for _ in range(100):
         g, dg = g_and_slope(beta)
         lo = np.where(g < 0, beta, lo)

@@ -51,6 +51,8 @@ def test_interpolate_at_nodes_returns_the_vectors(cli, product, polar_truth, tmp
     d = json.loads(r.stdout)
     p = np.stack([d["x_m"], d["y_m"], d["z_m"]], -1)
     assert np.abs(p - sv.position[:4]).max() < 1e-6 and d["frame"] == "ECI" and len(d["utc"]) == 4
+    r = cli("orbit", "interpolate", product, "--times", "2002-06-16T15:49:00Z,1e3", "--json")
+    assert json.loads(r.stdout)["time_s"] == [480.0, 1000.0]  # the epoch is 15:41:00
     csv = tmp_path / "o.csv"
     r = cli("orbit", "interpolate", product, "-t", "0,480", "--frame", "ecef", "--csv", csv, "--json")
     d = json.loads(r.stdout)
@@ -66,6 +68,7 @@ def test_interpolate_at_nodes_returns_the_vectors(cli, product, polar_truth, tmp
     (["--times", "7300"], "outside the state-vector span [0.000000, 6720.000000] s (use --extrapolate"),
     (["--times", "7300", "--extrapolate", "100"], "+ 100 s allowed extrapolation"),
     (["--times", "abc"], "cannot read 'abc'"),
+    (["--times", "2002-13-01T00:00:00Z"], "cannot read"),
     (["--times", "5:1:1"], "cannot read"),
     (["--times", "0", "--frame", "j2000"], "--frame must be"),
     (["--times", "0", "-n", "17"], "n_nodes must be in 2..16"),

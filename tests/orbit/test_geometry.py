@@ -175,6 +175,15 @@ def test_multi_pass_target_takes_the_pass_nearest_the_guess(ecef_truth):
     assert abs(t_a - t) < 1e-6 and abs(t_b - t - 6040) < 200
 
 
+def test_plane_solve_at_nadir_range(ecef_truth):
+    """Slant range equal to the nadir distance: the in-plane solve returns the nadir (look 0)."""
+    _, r, v, _ = _states(ecef_truth, 4)
+    p0, rho0 = G.target_from_look(r, v, 0.0)
+    assert np.abs(G.look_from_slant_range(r, v, rho0)).max() < 1e-5
+    with pytest.raises(GeometryError, match="no target on the Earth"):
+        G.look_from_slant_range(r, v, rho0 - 1.0)
+
+
 def test_look_incidence_range_relations(ecef_truth):
     _, r, v, _ = _states(ecef_truth, 5)
     look = np.radians(np.array([10.0, 20.0, 30.0, 40.0, 50.0]))

@@ -23,16 +23,21 @@ def _state_vectors(path: Path):
     return raw, StateVectors.from_record(raw.orbit, raw.epoch_utc)
 
 
-def parse_times(spec: str) -> list[float]:
-    """'0,12.5,30' (seconds after the epoch) and/or ranges 'start:stop:step' (stop included if on the grid)."""
+def parse_times(spec: str, epoch_utc: str) -> list[float]:
+    """'0,12.5,30' (seconds after the epoch), ranges 'start:stop:step' (stop included if on the grid) and
+    ISO-8601 UTC instants ('2002-06-16T15:41:02.5Z'), mixed freely."""
     import numpy as np
+
+    from orbit.timeutil import parse_utc
 
     out: list[float] = []
     for item in (s.strip() for s in spec.split(",")):
         if not item:
             continue
         try:
-            if ":" in item:
+            if "T" in item:
+                out.append((parse_utc(item) - parse_utc(epoch_utc)).total_seconds())
+            elif ":" in item:
                 a, b, c = (float(x) for x in item.split(":"))
                 if c <= 0 or b < a:
                     raise ValueError
@@ -43,8 +48,8 @@ def parse_times(spec: str) -> list[float]:
             else:
                 out.append(float(item))
         except ValueError:
-            raise SarcliError(f"--times: cannot read {item!r}; use numbers (s after the epoch) or "
-                              "start:stop:step with step > 0") from None
+            raise SarcliError(f"--times: cannot read {item!r}; use numbers (s after the epoch), "
+                              "start:stop:step with step > 0, or ISO-8601 UTC times") from None
     if not out:
         raise SarcliError("--times is empty")
     return out
@@ -169,7 +174,8 @@ def _gha_minus_gmst_deg(path: Path) -> float | None:
 def interpolate_cmd(
     raw_path: Path = typer.Argument(..., help="Raw product (HDF5) with /orbit."),
     times: str = typer.Option(..., "--times", "-t",
-                              help="Seconds after the product epoch: '0,10.5' and/or 'start:stop:step'."),
+                              help="Seconds after the product epoch ('0,10.5', 'start:stop:step') "
+                                   "and/or ISO-8601 UTC times."),
     frame: str = typer.Option("native", "--frame", help="Output frame: native (as stored), eci or ecef."),
     n_nodes: int = typer.Option(None, "--n-nodes", "-n", help="Hermite nodes N (2..16); default from the table."),
     extrapolate: float = typer.Option(0.0, "--extrapolate", help="Allow times up to this many s outside the span."),
@@ -188,6 +194,8 @@ def interpolate_cmd(
 
       sarcli orbit interpolate raw.h5 --times 0:10:0.5 --frame ecef --json
 
+      sarcli orbit interpolate raw.h5 --times 2002-06-16T15:41:02.5Z
+
       sarcli orbit interpolate raw.h5 --times 0:6720:60 --frame ecef --csv orbit.csv
     """
     import numpy as np
@@ -204,7 +212,7 @@ def interpolate_cmd(
         sv = sv.to_ecef()
     elif frame == "eci":
         sv = sv.to_eci()
-    t = np.array(parse_times(times))
+    t = np.array(parse_times(times, raw.epoch_utc))
     try:
         p, v, a = sv.interpolate(t, n_nodes, max_extrapolation_s=extrapolate)
     except InterpolationRangeError as e:
