@@ -14,7 +14,7 @@ Doppler sign (phase exp(-j*4*pi*R/lam), R = |p - r|):
 Surfaces of height h
     Solves first use the ellipsoid with semi-axes (a + h, b + h), then correct the offset with the true
     geodetic height of the solution (pyproj) until it is within 0.1 mm of h: exact heights, not the
-    (a + h, b + h) approximation (which is off by up to ~1 m at h = 5 km, see the tests).
+    (a + h, b + h) approximation (off by up to 7 mm at h = 5 km, 11 mm at 8 km; see the tests).
 """
 
 from __future__ import annotations

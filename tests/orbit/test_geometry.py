@@ -43,6 +43,16 @@ def test_target_from_look_satisfies_every_constraint(ecef_truth, look_deg, h):
         assert np.abs(rho - (hs - h)).max() < 1e-4
 
 
+def test_offset_ellipsoid_alone_is_not_a_constant_height_surface():
+    """Why the solves correct the (a + h, b + h) ellipsoid with pyproj heights: it is mm off at 5 km."""
+    from orbit.constants import WGS84_A, WGS84_B
+
+    th = np.radians(np.linspace(0.0, 90.0, 91))
+    p = np.stack([(WGS84_A + 5e3) * np.cos(th), 0 * th, (WGS84_B + 5e3) * np.sin(th)], -1)
+    err = np.abs(ecef_to_geodetic(p)[2] - 5e3)
+    assert 5e-3 < err.max() < 1e-2 and err[0] < 1e-6 and err[-1] < 1e-6
+
+
 def test_look_that_misses_the_earth_is_a_clear_error(ecef_truth):
     _, r, v, _ = _states(ecef_truth, 3)
     with pytest.raises(GeometryError, match=r"misses the Earth \(horizon at 6\d\.\d+ deg\)") as e:
