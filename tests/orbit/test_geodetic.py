@@ -30,3 +30,14 @@ def test_agrees_with_erfa_gc2gd():
     assert np.abs(np.radians(lat) - phi).max() * 6.4e6 < 1e-5  # ERFA itself is good to ~us
     assert np.abs(np.radians(lon) - elong).max() * 6.4e6 < 1e-6
     assert np.abs(h - height).max() < 1e-6
+
+
+def test_proj_inverse_alone_is_mm_off_at_orbit_height():
+    """The reason for the Newton polish: PROJ's non-iterative inverse at 800 km altitude."""
+    from orbit.geodetic import _to_geodetic
+
+    lat = np.linspace(-80, 80, 161)
+    r = geodetic_to_ecef(lat, 0 * lat + 10.0, 0 * lat + 8e5)
+    _, la, h = _to_geodetic().transform(r[:, 0], r[:, 1], r[:, 2])
+    assert np.abs(np.asarray(h) - 8e5).max() > 1e-3  # ~5 mm
+    assert np.abs(ecef_to_geodetic(r)[2] - 8e5).max() < 1e-7
