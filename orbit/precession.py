@@ -12,7 +12,7 @@ rotations R1, R2, R3 as ``orbit.frames._rz``):
     r_GMSTframe = R3(EE) r_TOD        (so that r_ECEF = R3(GMST) r_GMSTframe = R3(GAST) r_TOD)
 
 dpsi, deps: the IAU 1980 series truncated to its ``N_TERMS`` largest terms (measured against ERFA's
-full 106-term nut80 in the tests: <= 15 mas within +-8 years of J2000, i.e. < 0.5 m at the ground).
+full 106-term nut80 in the tests: <= 16 mas within +-8 years of J2000, i.e. < 0.5 m at the ground).
 The ~23 mas frame bias between J2000 and the GCRS, polar motion and UT1-UTC are not modelled (see
 ``orbit.frames``).
 Velocities are rotated with the same matrix: the precession/nutation rates (< 1e-11 rad/s) change

@@ -4,7 +4,7 @@ Documented model differences: our ECI frame is astropy's TEME; GMST is computed 
 polar motion is ignored. With astropy's own UT1-UTC and polar motion applied to our result the two
 must agree to < 1 mm; without them the difference is bounded by those two terms. The J2000 path
 (IAU 1976/1980, 20 nutation terms, no frame bias) agrees with astropy's GCRS -> ITRS to < 1.5 m at
-orbit radius (frame bias 23 mas + truncated nutation <= 15 mas + IAU 2006/2000A differences).
+orbit radius (frame bias 23 mas + truncated nutation <= 16 mas + IAU 2006/2000A differences).
 """
 
 from __future__ import annotations
