@@ -23,12 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from orbit.constants import OMEGA_EARTH, WGS84_A, WGS84_B
+from orbit.constants import OMEGA_EARTH
+from orbit.errors import GeometryError
 from orbit.frames import gmst
 from orbit.geodetic import ecef_to_geodetic, geodetic_to_ecef
-from orbit.pointing import ellipsoid_normal
-
-_BISECT = 64
+from orbit.geometry import target_in_plane
+from orbit.pointing import ellipsoid_normal, side_sign
 
 
 def _unit(x: np.ndarray) -> np.ndarray:
@@ -88,53 +88,63 @@ def range_derivatives(r, v, a, p, pd, pdd):
     return R, Rd, Rdd
 
 
-def surface_point(r: np.ndarray, n: np.ndarray, rho: np.ndarray, h: np.ndarray, toward: np.ndarray,
-                  frame: str) -> np.ndarray:
-    """Point(s) p with |p - r| = rho, (p - r).n = 0, on the surface at height h, on the side of ``toward``.
+def surface_point(r: np.ndarray, n: np.ndarray, rho: np.ndarray, h: float, side: str, frame: str) -> np.ndarray:
+    """Point(s) p with |p - r| = rho, (p - r).n = 0 on the surface at height h, on the looking ``side``.
 
-    Surface: WGS-84 ellipsoid at geodetic height h (ECI/ECEF; rotation about Z leaves it unchanged)
-    or the plane z = h (LOCAL). The circle of radius rho about r in the plane normal to n is
-    parametrized from its lowest point by the angle alpha in [0, pi/2] towards ``toward`` and the
-    crossing is bisected (64 steps: float64-exact); geodetic height is then corrected with pyproj
-    (3 rounds). NaN where the circle misses the surface (range shorter than the altitude or beyond
-    the horizon). Arrays broadcast: r, n, toward (m, 3); rho, h (m,).
+    Ellipsoid frames (ECI or ECEF: the WGS-84 surface is symmetric about Z) use
+    ``orbit.geometry.target_in_plane`` (exact geodetic height). LOCAL: the plane z = h in closed form,
+    p = r + rho (cos(a) e1 + sin(a) e2) with e1 the downward direction in the plane and e2 towards the
+    side, a in [0, pi/2] solving r_z + rho (cos(a) e1_z + sin(a) e2_z) = h. ``rho`` is (m,) increasing
+    (or a single value), r and n (3,). NaN rows where the range does not reach the surface.
     """
-    r, n, toward = (np.asarray(x, np.float64) for x in (r, n, toward))
-    rho, h = np.broadcast_arrays(np.asarray(rho, np.float64), np.asarray(h, np.float64))
-    r, n, toward = (np.broadcast_to(x, rho.shape + (3,)) for x in (r, n, toward))
-    n = _unit(n)
-    down = np.broadcast_to([0.0, 0.0, -1.0], r.shape) if frame == "LOCAL" else -_unit(r)
-    e1 = _unit(down - _dot(down, n)[..., None] * n)
-    e2 = np.cross(n, e1)
-    e2 = np.where((_dot(e2, toward) < 0)[..., None], -e2, e2)
+    r = np.asarray(r, np.float64)
+    n = _unit(np.asarray(n, np.float64))
+    rho = np.atleast_1d(np.asarray(rho, np.float64))
+    if frame == "LOCAL":
+        down = np.array([0.0, 0.0, -1.0])
+        e1 = _unit(down - (down @ n) * n)
+        e2 = side_sign(side) * np.cross(e1, n)
+        amp = np.hypot(e1[2], e2[2])
+        phi0 = np.arctan2(e2[2], e1[2])
+        with np.errstate(invalid="ignore"):
+            d = np.arccos((h - r[2]) / (rho * amp))
+        best = np.full(rho.shape, np.nan)
+        for cand in (np.mod(phi0 + d, 2 * np.pi), np.mod(phi0 - d, 2 * np.pi)):
+            ok = (cand <= np.pi / 2 + 1e-12) & np.isnan(best)
+            best = np.where(ok, cand, best)
+        return r + rho[:, None] * (np.cos(best)[:, None] * e1 + np.sin(best)[:, None] * e2)
 
-    def point(alpha):
-        return r + rho[..., None] * (np.cos(alpha)[..., None] * e1 + np.sin(alpha)[..., None] * e2)
+    def solve(sl):
+        return target_in_plane(r, n, 0.0, rho[sl], side=side, h=h)
 
-    def f(alpha, hh):
-        p = point(alpha)
-        if frame == "LOCAL":
-            return p[..., 2] - hh
-        return (p[..., 0] ** 2 + p[..., 1] ** 2) / (WGS84_A + hh) ** 2 + p[..., 2] ** 2 / (WGS84_B + hh) ** 2 - 1.0
+    def valid(i):
+        try:
+            solve(slice(i, i + 1))
+            return True
+        except GeometryError:
+            return False
 
-    hh = h.copy()
-    for _ in range(1 if frame == "LOCAL" else 4):
-        lo = np.zeros_like(rho)
-        hi = np.full_like(rho, np.pi / 2)
-        ok = (f(lo, hh) < 0) & (f(hi, hh) > 0)
-        for _ in range(_BISECT):
-            mid = 0.5 * (lo + hi)
-            neg = f(mid, hh) < 0
-            lo = np.where(neg, mid, lo)
-            hi = np.where(neg, hi, mid)
-        p = point(0.5 * (lo + hi))
-        p[~ok] = np.nan
-        if frame != "LOCAL":
-            good = np.isfinite(p[..., 0])
-            if np.any(good):
-                _, _, h_now = ecef_to_geodetic(p[good])
-                hh[good] += h[good] - h_now
-    return p
+    out = np.full((rho.size, 3), np.nan)
+    try:
+        return solve(slice(None))
+    except GeometryError:
+        pass
+    # the valid ranges form one interval [nadir, horizon]: bracket it by bisection, then solve it at once
+    inside = [i for i in (0, rho.size // 2, rho.size - 1) if valid(i)]
+    if not inside:
+        return out
+    lo_ok, hi_ok = inside[0], inside[-1]
+    lo, hi = 0, lo_ok
+    while lo < hi:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if valid(mid) else (mid + 1, hi)
+    first = lo
+    lo, hi = hi_ok, rho.size - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        lo, hi = (mid, hi) if valid(mid) else (lo, mid - 1)
+    out[first:lo + 1] = solve(slice(first, lo + 1))
+    return out
 
 
 def enu_basis(p: np.ndarray, frame: str) -> np.ndarray:

@@ -206,3 +206,30 @@ def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_of
             inside = (n[None, :] >= n_lo[:, None]) & (n[None, :] <= n_hi[:, None])
             sig = (amp[i] * g * np.exp(-4j * np.pi * rc / lam))[:, None] * np.exp(1j * np.pi * kr * tau**2)
             out[c, ks[:, None], n[None, :]] += np.where(inside, sig, 0)
+
+
+def splat_reference(grid, line0, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
+                    migrate, pattern, laz, lel):
+    """Plain-numpy reference of :func:`splat_kernel` (same arguments, no block)."""
+    n_ch, n_lines, n_l = grid.shape
+    for i in range(tp.shape[0]):
+        ks = np.arange(max(k0[i], line0), min(k1[i], line0 + n_lines))
+        if ks.size == 0:
+            continue
+        q = tp[i] + tv[i] * (t[ks] - tref[i])[:, None]
+        d = np.einsum("kij,kj->ki", rot[ks], q) - rp[ks]
+        rtx = np.linalg.norm(d, axis=1)
+        g = np.ones_like(rtx)
+        if pattern:
+            g = (np.sinc(laz * np.einsum("ki,ki->k", d, ux[ks]) / rtx) ** 2
+                 * np.sinc(lel * np.einsum("ki,ki->k", d, ue[ks]) / rtx) ** 2)
+        for c in range(n_ch):
+            rc = rtx if rx_off[c] == 0 else 0.5 * (rtx + np.linalg.norm(d - rx_off[c] * ux[ks], axis=1))
+            x = 2.0 * (rc if migrate else np.full_like(rc, r0[i])) / C * fq - x0
+            j = np.floor(x).astype(np.int64)
+            ok = (j >= 0) & (j + 1 < n_l)
+            f = x - j
+            z = amp[i] * g * np.exp(-4j * np.pi * rc / lam)
+            rows = ks[ok] - line0
+            np.add.at(grid[c], (rows, j[ok]), (z * (1.0 - f))[ok])
+            np.add.at(grid[c], (rows, j[ok] + 1), (z * f)[ok])

@@ -55,8 +55,8 @@ def place(ctx, traj, motion: Motion, where: tuple) -> tuple[np.ndarray, float, n
         t_ref = 0.0
     else:
         rho, t_ref, h = where[1], where[2], where[3]
-        r, ux, ub = _axes_at(ctx, traj, t_ref)
-        p = surface_point(r[None], ux[None], np.array([rho]), np.array([h]), ub[None], traj.frame)[0]
+        r, ux, _ = _axes_at(ctx, traj, t_ref)
+        p = surface_point(r, ux, np.array([rho]), h, ctx.scene.radar.look_side, traj.frame)[0]
         if not np.all(np.isfinite(p)):
             from sarcli.errors import FormatError
 

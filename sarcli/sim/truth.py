@@ -96,8 +96,8 @@ def doppler_truth(ctx, traj, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     """(f_dc, f_R) per range sample at the scene centre (module docstring)."""
     sc = ctx.scene
     rho = sc.radar.slant_range()
-    r, v, a, ux, ub = _axes(ctx, traj, np.zeros(1))
-    p = surface_point(r, ux, rho, np.full(rho.size, sc.reference_height_m), ub, traj.frame)
+    r, v, a, ux, _ = _axes(ctx, traj, np.zeros(1))
+    p = surface_point(r[0], ux[0], rho, sc.reference_height_m, sc.radar.look_side, traj.frame)
     good = np.isfinite(p[:, 0])
     fdc = np.full(rho.size, np.nan)
     fr = np.full(rho.size, np.nan)
