@@ -22,6 +22,7 @@ pulse being centred on its delay) and the azimuth (pulse) time of its centre lin
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -70,7 +71,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                      n_nodes: int | None = None, exact_attitude: bool = True, height_m: float | None = None,
                      half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
                      min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
-                     mapdrift_segments: int = 4, dataonly_rg_block: int = 128) -> DopplerModel:
+                     mapdrift_segments: int = 4, dataonly_rg_block: int | None = None) -> DopplerModel:
     """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
 
     ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
@@ -162,9 +163,10 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         if not res.resolved and _can_compress(raw):
             n_d, c_d, _ = run_data_only()
             n_lo, n_hi = int(np.floor(res.offset_prf)), int(np.ceil(res.offset_prf))
-            if n_d in (n_lo, n_hi) and c_d > 0:
-                res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, half_tolerance)
-                source, conf = "orbit+data", max(conf, c_d)
+            if n_d in (n_lo, n_hi) and c_d > 0:  # keep the orbit margin: it is what was ambiguous
+                res_d = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, half_tolerance)
+                res = dataclasses.replace(res_d, margin=res.margin, offset_prf=res.offset_prf, resolved=False)
+                source, conf = "orbit+data", c_d
     elif mode == "data":
         n_d, conf, _ = run_data_only()
         res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, half_tolerance)
@@ -176,13 +178,15 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
 
     # 4. 2-D fit with outlier flags. With an orbit the geometric model gives the SHAPE of the centroid
     # over the scene (exact to < 0.001 Hz) and the data its offset: the blocks fit a low-order residual
-    # (data - model), and the model + residual is sampled on a dense grid and fitted by a higher-order
-    # polynomial (noise-free, fit error reported). Without an orbit the blocks are fitted directly.
+    # (data - model; a slope only with >= 8 distinct block coordinates on that axis: the residual is
+    # mostly the attitude-knowledge offset), and the model + residual is sampled on a dense grid and
+    # fitted by a higher-order polynomial (noise-free, fit error reported). Without an orbit the blocks
+    # are fitted directly.
     GR, GT = _model_grid(raw)
     fit_info: dict[str, Any] = {}
     if geo is not None:
         resid, outl = fit_poly2d(Rg, T, fdc_abs - fdc_orbit, w, resid_degree, k_sigma=outlier_sigma,
-                                 floor=0.002 * prf, points_per_coef=2)
+                                 floor=0.002 * prf, points_per_coef=4)
         g_orbit = geo.fdc_vector(GR, GT) if fdc_model == "vector" else geo.fdc_closed(GR, GT)
         target = g_orbit + resid(GR, GT)
         fdc_poly, _ = fit_poly2d(GR, GT, target, np.ones_like(GR), model_degree, k_sigma=np.inf)
@@ -266,7 +270,8 @@ def _model_grid(raw: RawProduct, n_r: int = 24, n_t: int = 8) -> tuple[np.ndarra
 
 
 def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int):
-    """Map-drift rate per range segment over the whole azimuth extent; linear fit in range."""
+    """Map-drift rate per range segment over the whole azimuth extent; linear fit in range of the
+    segments that converged to within 30 % of their start value."""
     from sarcli.doppler.mapdrift import map_drift
     from sarcli.doppler.rangecomp import range_compress_valid
 
@@ -287,12 +292,15 @@ def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_s
             v = radar.platform_velocity_mps or v_guess
             fr0 = -2.0 * v**2 / (radar.wavelength_m * r_seg)
         res = map_drift(rc[:, a:b], radar.prf_hz, radar.wavelength_m, r_seg, dr, fdc, fr0)
-        rng.append(r_seg)
-        frs.append(res.fr_hz_per_s)
+        ok = res.converged and res.fr_hz_per_s < 0 and abs(res.fr_hz_per_s / fr0 - 1.0) < 0.3
         info.append({"range_m": r_seg, "fr_hz_per_s": res.fr_hz_per_s, "start_hz_per_s": fr0,
-                     "iterations": res.iterations, "converged": res.converged})
+                     "iterations": res.iterations, "converged": res.converged, "used": bool(ok)})
+        if ok:  # a segment without focusable content (noise, dark sea) does not converge: dropped
+            rng.append(r_seg)
+            frs.append(res.fr_hz_per_s)
     if not frs:
-        raise SarcliError("map-drift: range extent too short after range compression")
+        raise SarcliError("map-drift did not converge in any range segment (no focusable scene content?); "
+                          "give the Doppler rate another way (--fr-method orbit needs state vectors)")
     rr = np.array(rng)
     poly, _ = fit_poly2d(rr, np.full(rr.size, t_c), np.array(frs), np.ones(rr.size), (1, 0), k_sigma=np.inf)
     return poly, poly(Rg, T), info

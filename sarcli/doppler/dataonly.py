@@ -81,11 +81,18 @@ def _finish(method: str, vals: np.ndarray, w: np.ndarray, fdc_bb: float, prf: fl
     return DataOnlyEstimate(method, mean, sigma, n, conf, vals)
 
 
-def mlcc(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int = 256,
+def _auto_block(rg_block: int | None, n_valid: int) -> int:
+    """Range block of the data-only estimators: given, or n_valid/8 clipped to 16..128 (the block
+    scatter needs several blocks to say anything about the confidence)."""
+    return int(rg_block) if rg_block else max(16, min(128, n_valid // 8))
+
+
+def mlcc(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int | None = None,
          replica: np.ndarray | None = None) -> DataOnlyEstimate:
     """MLCC absolute centroid (Hz) and ambiguity relative to the scene baseband centroid ``fdc_bb``."""
     lo, hi, fc = range_looks(echo, radar, replica)
     n_lines = echo.shape[0]
+    rg_block = _auto_block(rg_block, lo.shape[1])
     b_lo = block_correlation(lo, n_lines, rg_block)
     b_hi = block_correlation(hi, n_lines, rg_block)
     dphi = np.angle(b_hi.phase_rho() * np.conj(b_lo.phase_rho()))[0]
@@ -94,12 +101,12 @@ def mlcc(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int = 256,
     return _finish("mlcc", vals, w, fdc_bb, radar.prf_hz)
 
 
-def mlbf(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int = 128,
+def mlbf(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int | None = None,
          replica: np.ndarray | None = None) -> DataOnlyEstimate:
     """MLBF absolute centroid (Hz) and ambiguity relative to the scene baseband centroid ``fdc_bb``."""
     lo, hi, fc = range_looks(echo, radar, replica)
     beat = lo * np.conj(hi)
-    bc = block_correlation(beat, echo.shape[0], rg_block)
+    bc = block_correlation(beat, echo.shape[0], _auto_block(rg_block, beat.shape[1]))
     f_beat = bc.baseband(radar.prf_hz)[0]
     vals = -f_beat * radar.carrier_frequency_hz / (fc[1] - fc[0])
     return _finish("mlbf", vals, bc.weight()[0], fdc_bb, radar.prf_hz)
