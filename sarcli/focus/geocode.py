@@ -88,12 +88,19 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None) -> None:
     """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326)."""
+    import warnings
+
+    from rasterio.errors import NotGeoreferencedWarning
+
     from sarcli.io.images import write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg)
     gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg)
-    write_geotiff(path, np.sqrt(inten), 4326, gcps=gcps, tags=tags,
-                  band_description="amplitude, slant-range geometry (lines: zero-Doppler time)")
+    with warnings.catch_warnings():
+        # the GCPs are attached after the file is opened: rasterio warns in between
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        write_geotiff(path, np.sqrt(inten), 4326, gcps=gcps, tags=tags,
+                      band_description="amplitude, slant-range geometry (lines: zero-Doppler time)")
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
