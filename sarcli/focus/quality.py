@@ -223,3 +223,18 @@ def measure_targets(slc, positions: list[tuple[float, float]], truth_known: bool
                         "position_error_azimuth_px": m["row"] - row})
         out.append(rec)
     return out
+
+
+def image_statistics(image: np.ndarray) -> dict:
+    """Focus-quality statistics of an image region (no targets needed), computed on intensity I = |z|^2.
+
+    contrast = std(I) / mean(I) (higher = sharper; 1 for fully developed speckle);
+    entropy = -sum(p ln p), p = I / sum(I) (lower = sharper; the autofocus criterion).
+    """
+    inten = np.abs(np.asarray(image, np.complex128)) ** 2
+    total = inten.sum()
+    if not total > 0:
+        raise SarcliError("image has no signal: statistics undefined")
+    p = inten[inten > 0] / total
+    return {"contrast": float(inten.std() / inten.mean()), "entropy": float(-np.sum(p * np.log(p))),
+            "n_pixels": int(inten.size)}

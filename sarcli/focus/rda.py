@@ -129,18 +129,26 @@ def doppler_on_grid(doppler, r0: np.ndarray, t: float, wavelength: float):
 
 
 def _coverage_warnings(doppler, r: np.ndarray, t: np.ndarray) -> list[str]:
-    """Warn when the scene lies outside the range/time span the Doppler model was estimated on."""
+    """Warn when the scene reaches beyond the blocks the Doppler model was estimated on.
+
+    A block covers half the spacing of the block centres either side (a single block: the whole
+    scene); beyond that the model is extrapolated.
+    """
     blocks = getattr(doppler, "blocks", None)
     out = []
-    if isinstance(blocks, dict) and "range_m" in blocks and "azimuth_time_s" in blocks:
-        br, bt = np.asarray(blocks["range_m"], float), np.asarray(blocks["azimuth_time_s"], float)
-        if br.size and (r[0] < br.min() - 0.5 * np.ptp(r) or r[-1] > br.max() + 0.5 * np.ptp(r)):
-            out.append(f"Doppler table covers ranges {br.min():.0f}-{br.max():.0f} m, scene {r[0]:.0f}-{r[-1]:.0f} m:"
-                       " extrapolating")
-        span = max(np.ptp(t), 1e-9)
-        if bt.size and (t[0] < bt.min() - 0.5 * span or t[-1] > bt.max() + 0.5 * span):
-            out.append(f"Doppler table covers times {bt.min():.3f}-{bt.max():.3f} s, scene {t[0]:.3f}-{t[-1]:.3f} s:"
-                       " extrapolating")
+    if not (isinstance(blocks, dict) and "range_m" in blocks and "azimuth_time_s" in blocks):
+        return out
+    for name, axis, centres, unit in (("ranges", r, blocks["range_m"], "m"),
+                                      ("times", t, blocks["azimuth_time_s"], "s")):
+        c = np.unique(np.asarray(centres, float))
+        if c.size == 0:
+            continue
+        half = 0.5 * float(np.median(np.diff(c))) if c.size > 1 else 0.5 * float(np.ptp(axis))
+        half *= 1.01
+        lo, hi = c.min() - half, c.max() + half
+        if axis[0] < lo or axis[-1] > hi:
+            out.append(f"Doppler table covers {name} {lo:.6g}-{hi:.6g} {unit}, scene {axis[0]:.6g}-{axis[-1]:.6g}"
+                       f" {unit}: extrapolating")
     return out
 
 

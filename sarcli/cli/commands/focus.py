@@ -134,10 +134,13 @@ def focus(
         info(f"sarcli: warning: {w.message}", as_json)
     products = {"slc": str(output)}
     t0 = time.perf_counter()
-    if geotiff or geotiff_slant or quicklook:
-        from sarcli.io.slc import read_slc
+    from sarcli.focus.quality import image_statistics
+    from sarcli.io.slc import read_slc
 
-        full = read_slc(output)
+    full = read_slc(output)
+    a, b = max(0, full.first_full_line), min(full.image.shape[0], full.last_full_line + 1)
+    stats = image_statistics(full.image[a:b] if b > a else full.image) if np.any(full.image) else {}
+    if geotiff or geotiff_slant or quicklook:
         tags = {"source_product": output.name, "algorithm": algorithm, "doppler": how}
         if geotiff_slant:
             from sarcli.focus.geocode import write_slant_geotiff
@@ -167,6 +170,7 @@ def focus(
             "fr_hz_per_s_mid": float(np.median(d.fr_hz_per_s[:, d.fr_hz_per_s.shape[1] // 2])),
             "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, d.velocity_mps.shape[1] // 2])),
         },
+        "image_statistics": stats,
         "timings_s": {"doppler": t_doppler, **slc.timings, "geotiff_quicklook": t_products,
                       "total": time.perf_counter() - t_start},
         "peak_rss_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
