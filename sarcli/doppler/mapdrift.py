@@ -8,9 +8,12 @@ at Doppler f_k is displaced by (f_k - fdc)*(1/fr - 1/fr0). Two looks at f_1 < f_
 
     d_eta = eta_2 - eta_1 = (f_2 - f_1) * (1/fr - 1/fr0)   ->   1/fr = 1/fr0 + d_eta / (f_2 - f_1).
 
+f_1, f_2 are the energy-weighted mean Doppler frequencies of the looks (the antenna pattern weights
+the spectrum: with the band centres instead the update under-corrects by ~30 %).
 d_eta is the peak of the azimuth cross-correlation of the two look intensities summed over range
 (parabolic sub-sample interpolation). The estimate is iterated (fr0 <- fr) until it moves by less
-than ``tol`` (relative).
+than ``tol`` (relative), or until the last three iterates lie within 10 ``tol`` (they then oscillate
+on the speckle noise floor of the drift measurement; their mean is returned).
 
 Before compression the range migration is removed in the range-Doppler domain with the hyperbolic
 model R(f) = R0 / D(f), D = sqrt(1 - (lam*f/(2*Vr))^2), Vr^2 = -fr0*lam*R0/2 (re-derived each
@@ -73,8 +76,9 @@ def map_drift(rc: np.ndarray, prf: float, wavelength: float, range_m: float, ran
     half = 0.5 * look_fraction * prf
     sel1 = (df >= -half) & (df < 0)
     sel2 = (df >= 0) & (df < half)
-    f1, f2 = df[sel1].mean(), df[sel2].mean()
     S = sfft.fft(np.asarray(rc, np.complex64), axis=0, workers=-1)
+    power = np.mean(np.abs(S) ** 2, axis=1)  # azimuth spectrum: the looks' energy-weighted centres
+    f1, f2 = (float(np.sum(df[m] * power[m]) / np.sum(power[m])) for m in (sel1, sel2))
     S = sfft.fft(S, axis=1, workers=-1)  # 2-D spectrum (f_eta rows, f_range columns)
     k_rg = sfft.fftfreq(n_rg)  # cycles per sample
     fr = float(fr0)
@@ -102,6 +106,11 @@ def map_drift(rc: np.ndarray, prf: float, wavelength: float, range_m: float, ran
         if not (fr < 0 and np.isfinite(fr)):
             break
         if rel < tol:
+            converged = True
+            break
+        last = np.array(history[-3:])
+        if iterations >= 3 and np.ptp(last) < 10 * tol * abs(fr):  # oscillating on the speckle noise floor
+            fr = float(last.mean())
             converged = True
             break
     return MapDriftResult(fr, iterations, history, float(drift), converged)

@@ -1,0 +1,79 @@
+"""`sarcli doppler` end to end on a small simulated scene, the doppler.h5 round trip, bad inputs."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from sarcli.doppler.api import estimate_doppler
+from sarcli.io.doppler_product import read_doppler
+from sarcli.io.raw import write_raw
+
+JSON_KEYS = {"prf_hz", "fdc_baseband_hz", "ambiguity", "ambiguity_source", "ambiguity_confidence", "fdc_hz",
+             "fr_hz_per_s", "blocks"}
+BLOCK_KEYS = {"range_m", "azimuth_time_s", "fdc_baseband_hz", "quality", "ambiguity", "fdc_hz", "fr_hz_per_s"}
+
+
+@pytest.fixture(scope="module")
+def raw_file(tmp_path_factory, clutter_raw):
+    p = tmp_path_factory.mktemp("dop") / "raw.h5"
+    write_raw(p, clutter_raw)
+    return p
+
+
+def test_cli_json_product_and_plot(cli, raw_file, tmp_path, clutter_raw):
+    out, png = tmp_path / "doppler.h5", tmp_path / "doppler.png"
+    r = cli("doppler", raw_file, "--json", "-o", out, "--plot", png, "--az-block", "512", "--rg-block", "96")
+    assert r.exit_code == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert JSON_KEYS <= set(d)
+    assert d["ambiguity_source"] == "orbit" and 0.0 <= d["ambiguity_confidence"] <= 1.0
+    assert len(d["blocks"]) == 4 and BLOCK_KEYS <= set(d["blocks"][0])
+    assert d["fdc_hz"] == pytest.approx(d["fdc_baseband_hz"] + d["ambiguity"] * d["prf_hz"], abs=0.1 * d["prf_hz"])
+    assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+    m = read_doppler(out)
+    ref = estimate_doppler(clutter_raw, az_block=512, rg_block=96)
+    rho = clutter_raw.slant_range()
+    t = np.linspace(clutter_raw.azimuth_time[0], clutter_raw.azimuth_time[-1], rho.size)
+    np.testing.assert_allclose(m.fdc(rho, t), ref.fdc(rho, t), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(m.fr(rho, t), ref.fr(rho, t), rtol=1e-14)
+    assert m.summary["ambiguity"] == d["ambiguity"] and m.parameters["az_block"] == 512
+    np.testing.assert_array_equal(m.blocks["ambiguity"], [b["ambiguity"] for b in d["blocks"]])
+    assert m.blocks["valid"].dtype == bool
+    h = cli("doppler", "--help")
+    assert "Examples:" in h.stdout
+
+
+def test_cli_human_summary_on_stderr(cli, raw_file):
+    r = cli("doppler", raw_file, "--az-block", "512", "--rg-block", "96")
+    assert r.exit_code == 0 and r.stdout == ""
+    assert "fdc" in r.stderr and "ambiguity" not in r.stdout
+
+
+def test_cli_bad_inputs_one_line_errors(cli, tmp_path, clutter_raw, raw_file):
+    r = cli("doppler", tmp_path / "missing.h5")
+    assert r.exit_code != 0 and r.stderr.startswith("sarcli: error:") and len(r.stderr.strip().splitlines()) == 1
+    bad = clutter_raw.echo.copy()
+    bad[5, 5] = np.nan
+    p = tmp_path / "nan.h5"
+    write_raw(p, dataclasses.replace(clutter_raw, echo=bad))
+    r = cli("doppler", p)
+    assert r.exit_code != 0 and "NaN" in r.stderr and "Traceback" not in r.stderr
+    r = cli("doppler", raw_file, "--estimator", "bogus")
+    assert r.exit_code != 0 and "unknown estimator" in r.stderr
+    r = cli("doppler", raw_file, "--fit-degree", "x")
+    assert r.exit_code != 0 and "--fit-degree" in r.stderr
+    zero = tmp_path / "zero.h5"
+    write_raw(zero, dataclasses.replace(clutter_raw, echo=np.zeros_like(clutter_raw.echo)))
+    r = cli("doppler", zero)
+    assert r.exit_code != 0 and "usable Doppler signal" in r.stderr
+
+
+def test_read_doppler_refuses_other_products(tmp_path, raw_file):
+    from sarcli.errors import ProductError
+
+    with pytest.raises(ProductError, match="expected doppler"):
+        read_doppler(raw_file)
