@@ -25,22 +25,23 @@ from sarcli.gbsar.rangecomp import RangeProfiles
 WINDOW_CODE = {"none": 0, "hamming": 1, "hann": 2}
 
 
-@njit(cache=True)
-def _taper(code, t):
-    if code == 1:
-        return 0.54 - 0.46 * np.cos(2.0 * np.pi * t)
-    if code == 2:
-        return 0.5 - 0.5 * np.cos(2.0 * np.pi * t)
-    return 1.0
+_TABLE_N = 4097  # taper lookup table; linear interpolation error < 1e-7
+_W_MIN = 1e-9  # apertures whose taper weights sum below this (e.g. one stop on a Hann edge) give 0
 
 
-@njit(cache=True, parallel=True)
-def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, wcode, out):
+def taper_table(code: int) -> np.ndarray:
+    """Taper sampled on [0, 1] (``_TABLE_N`` points): 0 none, 1 Hamming, 2 Hann."""
+    t = np.linspace(0.0, 1.0, _TABLE_N)
+    return {0: np.ones_like(t), 1: 0.54 - 0.46 * np.cos(2 * np.pi * t), 2: 0.5 - 0.5 * np.cos(2 * np.pi * t)}[code]
+
+
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
+def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, table, out):
     """Backproject ``prof`` (n_stops, n_r) complex64 (ranges n*dr) onto pixels (px, pr) -> out (n_p,).
 
     Each pixel integrates the stops of its synthetic aperture ``[a, b]`` = rail ``[xs[0], xs[-1]]``
     intersected with the beam footprint ``|x - px| <= half_beam * pr`` (seed 000 eq. 22-40), weighted by
-    the taper ``wcode`` over [a, b] and normalized by the sum of the weights used.
+    the taper ``table`` (sampled on [0, 1]) over [a, b] and normalized by the sum of the weights used.
     """
     n_s, n_r = prof.shape
     for p in prange(px.shape[0]):
@@ -53,7 +54,11 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, wcode, out):
         for i in range(n_s):
             if valid[i] == 0.0 or xs[i] < a or xs[i] > b:
                 continue
-            w = _taper(wcode, (xs[i] - a) / span) if span > 0 else 1.0
+            w = 1.0
+            if span > 0:
+                q = (xs[i] - a) / span * (table.size - 1)
+                k = min(int(q), table.size - 2)
+                w = table[k] + (q - k) * (table[k + 1] - table[k])
             d = px[p] - xs[i]
             r = np.sqrt(d * d + r0sq + dz[i] * dz[i])
             f = r / dr
@@ -64,10 +69,10 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, wcode, out):
             v = prof[i, j] * (1.0 - t) + prof[i, j + 1] * t
             acc += w * v * np.exp(1j * kc * r)
             wsum += w
-        out[p] = acc * np.exp(-1j * kc * pr[p]) / wsum if wsum > 0 else 0j
+        out[p] = acc * np.exp(-1j * kc * pr[p]) / wsum if wsum > _W_MIN else 0j
 
 
-def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, wcode) -> np.ndarray:
+def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, wcode: int) -> np.ndarray:
     """Plain-numpy reference of :func:`bp_kernel`."""
     rgrid = np.arange(prof.shape[1]) * dr
     a = np.maximum(xs[0], px - half_beam * pr)
@@ -84,7 +89,7 @@ def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_be
         acc += np.where(use, w * v * np.exp(1j * kc * r), 0)
         wsum += np.where(use, w, 0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(wsum > 0, acc * np.exp(-1j * kc * pr) / wsum, 0)
+        return np.where(wsum > _W_MIN, acc * np.exp(-1j * kc * pr) / wsum, 0)
 
 
 def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_length_m: float | None,
@@ -104,5 +109,5 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_len
     kc = 4 * np.pi / prof.wavelength_m
     half = prof.wavelength_m / (2 * antenna_length_m) if antenna_length_m else 1e30
     bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
-              half, WINDOW_CODE[azimuth_window], out)
+              half, taper_table(WINDOW_CODE[azimuth_window]), out)
     return out.reshape(shape)

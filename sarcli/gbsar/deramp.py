@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
+from numba import njit, prange
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.rangecomp import RangeProfiles, stop_weights
@@ -94,11 +95,51 @@ def bilinear(data: np.ndarray, fi: np.ndarray, fj: np.ndarray) -> np.ndarray:
     return np.where(ok, v, 0).astype(np.complex64)
 
 
+@njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
+def polar_to_cartesian_kernel(data, r_first, dr, s_first, ds, ranges, azimuths, k4, out, covered):
+    """Bilinear resampling of the polar DF image ``data`` (n_rc, n_s) onto (R0 rows, x cols), with the
+    phase conversion ``exp(-j k4 (R0 - Rc))``; ``azimuths`` are relative to the rail centre."""
+    n_rc, n_s = data.shape
+    for i in prange(ranges.size):
+        r0 = ranges[i]
+        for j in range(azimuths.size):
+            x = azimuths[j]
+            rc = np.sqrt(x * x + r0 * r0)
+            s = x / rc if rc > 0 else 0.0
+            fi = (rc - r_first) / dr
+            fj = (s - s_first) / ds
+            if fi < 0 or fi > n_rc - 1 or fj < 0 or fj > n_s - 1:
+                out[i, j] = 0
+                covered[i, j] = False
+                continue
+            i0 = min(int(fi), n_rc - 2)
+            j0 = min(int(fj), n_s - 2)
+            ti = fi - i0
+            tj = fj - j0
+            v = ((data[i0, j0] * (1 - tj) + data[i0, j0 + 1] * tj) * (1 - ti)
+                 + (data[i0 + 1, j0] * (1 - tj) + data[i0 + 1, j0 + 1] * tj) * ti)
+            out[i, j] = v * np.exp(-1j * k4 * (r0 - rc))
+            covered[i, j] = True
+
+
 def geometric_correction(img: PolarImage, ranges: np.ndarray, azimuths: np.ndarray,
                          wavelength_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Resample the DF polar image onto the Cartesian grid (R0 rows, x columns) -> (image, covered mask)."""
     if img.ranges_m.size < 2 or img.sines.size < 2:
         raise SarcliError("the DF image is too small to resample")
+    r0 = np.ascontiguousarray(ranges, np.float64)
+    x = np.ascontiguousarray(np.asarray(azimuths, np.float64) - img.rail_centre_m)
+    out = np.empty((r0.size, x.size), np.complex64)
+    covered = np.empty((r0.size, x.size), np.bool_)
+    polar_to_cartesian_kernel(np.ascontiguousarray(img.data), float(img.ranges_m[0]),
+                              float(img.ranges_m[1] - img.ranges_m[0]), float(img.sines[0]),
+                              float(img.sines[1] - img.sines[0]), r0, x, 4 * np.pi / wavelength_m, out, covered)
+    return out, covered
+
+
+def geometric_correction_reference(img: PolarImage, ranges: np.ndarray, azimuths: np.ndarray,
+                                   wavelength_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Plain-numpy reference of :func:`geometric_correction`."""
     r0 = np.asarray(ranges, np.float64)[:, None]
     x = np.asarray(azimuths, np.float64)[None, :] - img.rail_centre_m
     rc = np.hypot(x, r0)

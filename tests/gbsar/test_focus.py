@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar import C_LIGHT
-from sarcli.gbsar.backprojection import bp_kernel, bp_reference
+from sarcli.gbsar.backprojection import bp_kernel, bp_reference, taper_table
 from sarcli.gbsar.focus import FocusOptions, Grid, focus_scan
 from sarcli.gbsar.rangecomp import range_compress
 from sarcli.gbsar.system import azimuth_resolution, df_min_range
@@ -29,7 +29,7 @@ def test_bp_kernel_matches_numpy_reference(seed, wcode, beam):
     dz = rng.uniform(-0.1, 0.1, 7)
     px, pr = rng.uniform(-2, 2, 30), rng.uniform(0.5, 9, 30)
     out = np.zeros(30, np.complex64)
-    bp_kernel(prof, 0.2, xs, dz, valid, px, pr, 400.0, beam, wcode, out)
+    bp_kernel(prof, 0.2, xs, dz, valid, px, pr, 400.0, beam, taper_table(wcode), out)
     ref = bp_reference(prof, 0.2, xs, dz, valid, px, pr, 400.0, beam, wcode)
     np.testing.assert_allclose(out, ref, atol=2e-5 * max(1.0, np.abs(ref).max()))
 
@@ -188,18 +188,17 @@ def test_rd_resolution_by_region(r0, xc):
 
 
 def test_df_resolution_far_range_uses_rc():
-    """Region II, DF: lam Rc/(2X) along the arc (eq. 31), off boresight."""
+    """Region II, DF: lam Rc/(2X) along the arc (eq. 31), off boresight, on DF's native polar grid."""
+    from sarcli.gbsar.deramp import focus_df
+
     r0, xc = 60.0, 4.0
     s = scan_of([(xc, r0)], bw=200e6, n=201)
     _, res = azimuth_resolution(r0, xc, 4.0, LAM, 0.25, "df")
     rc = np.hypot(r0, xc)
-    opts = FocusOptions(algorithm="df", azimuth_window="none", range_window="none", n_xfft=4096)
-    theta = np.arctan2(xc, r0) + np.linspace(-4, 4, 801) * res / rc
-    # sample the DF image along the circle of radius Rc: rows/cols are built per point
-    vals = [focus_scan(s, opts, grid=Grid(np.array([rc * np.cos(t)]), np.array([rc * np.sin(t)]))).image[0, 0, 0]
-            for t in theta[::20]]
-    w = width_at(np.array(vals), rc * theta[::20], 2 / np.pi)
-    assert w == pytest.approx(res, rel=0.10)
+    pol = focus_df(range_compress(s, "VV", "none", oversample=4), n_xfft=8192, azimuth_window="none")
+    row = pol.data[int(np.argmin(abs(pol.ranges_m - rc)))]
+    assert rc * pol.sines[int(np.argmax(np.abs(row)))] == pytest.approx(xc, abs=0.05)
+    assert width_at(row, rc * pol.sines, 2 / np.pi) == pytest.approx(res, rel=0.10)
 
 
 # ---------------------------------------------------------------- hard cases
@@ -271,3 +270,16 @@ def test_nan_sweep_is_flagged_and_skipped():
     a = peak_near(f.image[0], g.ranges, g.azimuths, 6.0, 0.0)[2]
     b = peak_near(clean.image[0], g.ranges, g.azimuths, 6.0, 0.0)[2]
     assert a == pytest.approx(b, rel=0.05)
+
+
+def test_geometric_correction_kernel_matches_numpy_reference():
+    from sarcli.gbsar.deramp import PolarImage, geometric_correction, geometric_correction_reference
+
+    rng = np.random.default_rng(4)
+    data = (rng.standard_normal((40, 16)) + 1j * rng.standard_normal((40, 16))).astype(np.complex64)
+    img = PolarImage(data=data, ranges_m=np.arange(40) * 0.5, sines=np.linspace(-0.3, 0.3, 16), rail_centre_m=0.2)
+    ranges, az = np.linspace(0.0, 21.0, 33), np.linspace(-5.0, 5.0, 27)
+    a, ca = geometric_correction(img, ranges, az, 0.0566)
+    b, cb = geometric_correction_reference(img, ranges, az, 0.0566)
+    np.testing.assert_array_equal(ca, cb)
+    np.testing.assert_allclose(a, b, atol=2e-4)
