@@ -18,7 +18,8 @@ from sarcli.errors import ProductError
 
 
 @contextlib.contextmanager
-def _atomic_path(path: str | os.PathLike, suffix: str):
+def atomic_path(path: str | os.PathLike, suffix: str):
+    """Yield a temporary file name in ``path``'s folder; it is renamed to ``path`` only on success."""
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
@@ -71,7 +72,7 @@ def write_geotiff(
     if transform is not None:
         profile["crs"] = crs_obj
         profile["transform"] = transform
-    with _atomic_path(path, ".tif") as tmp:
+    with atomic_path(path, ".tif") as tmp:
         with rasterio.open(tmp, "w", **profile) as dst:
             dst.write(a, 1)
             if gcps is not None:
@@ -133,6 +134,6 @@ def write_quicklook(
     ax.set_ylabel(ylabel)
     fig.colorbar(im, ax=ax, label=colorbar_label)
     fig.tight_layout()
-    with _atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")
     plt.close(fig)

@@ -17,7 +17,7 @@ def comparison_png(path: str | os.PathLike, images: dict[str, dict[str, np.ndarr
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from sarcli.io.images import _atomic_path
+    from sarcli.io.images import atomic_path
 
     n = len(images)
     fig, axes = plt.subplots(2, n, figsize=(3.2 * n, 7), dpi=100, squeeze=False)
@@ -42,6 +42,6 @@ def comparison_png(path: str | os.PathLike, images: dict[str, dict[str, np.ndarr
             axes[1, k].set_ylabel("azimuth PSF (dB)")
     fig.suptitle(title)
     fig.tight_layout()
-    with _atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")
     plt.close(fig)

@@ -405,9 +405,9 @@ def _ps_plot(path: Path, img, gamma, rows, cols, t, disp) -> None:
         a2.plot(np.asarray(t) / 60.0, disp[k], ".-")
     a2.set(xlabel="time (min)", ylabel="LOS displacement (mm)", title=f"{rows.size} PS (first 20 shown)")
     fig.tight_layout()
-    from sarcli.io.images import _atomic_path
+    from sarcli.io.images import atomic_path
 
-    with _atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")
     plt.close(fig)
 

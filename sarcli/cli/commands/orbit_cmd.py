@@ -244,10 +244,10 @@ def interpolate_cmd(
 def _write_csv(path: Path, cols: dict) -> None:
     import numpy as np
 
-    from sarcli.io.images import _atomic_path
+    from sarcli.io.images import atomic_path
 
     table = np.column_stack(list(cols.values()))
-    with _atomic_path(path, ".csv") as tmp:
+    with atomic_path(path, ".csv") as tmp:
         np.savetxt(tmp, table, delimiter=",", header=",".join(cols), comments="", fmt="%.10f")
 
 
@@ -308,7 +308,7 @@ def _accuracy_plot(path: Path, truth) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from sarcli.io.images import _atomic_path
+    from sarcli.io.images import atomic_path
 
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True, dpi=100)
     for N in (2, 4, 6, 8, 10, 12):
@@ -326,7 +326,7 @@ def _accuracy_plot(path: Path, truth) -> None:
     ax1.set_title("Hermite interpolation of 15 x 480 s state vectors vs J2 truth")
     ax1.legend(ncol=3, fontsize=8)
     fig.tight_layout()
-    with _atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")
     plt.close(fig)
 
