@@ -14,6 +14,7 @@ everywhere at no more than twice DF's time plus the near-range part.
 
 from __future__ import annotations
 
+import os
 import time
 import tracemalloc
 
@@ -148,7 +149,8 @@ def main() -> None:
     for name, cfg in CONFIGS.items():
         data["configs"][name] = _bench_config(name, cfg, rows, core_rows)
     md = ["# GB-SAR focusing benchmark (DF / RD / BP / auto)\n",
-          f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, 2 shared cores. Targets with the sinc "
+          f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, 2 shared cores, load average "
+          f"{os.getloadavg()[0]:.1f} at the end. Targets with the sinc "
           "antenna pattern; errors against truth (position) and against BP (amplitude, phase) at each target; "
           "'near' = targets nearer than the DF limit of eq. 12, 'far II' = beyond it and in region II (full rail "
           "aperture; in regions I/III/IV the algorithms' aperture tapers and normalizations differ by design, "

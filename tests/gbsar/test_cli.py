@@ -153,3 +153,11 @@ def test_help_has_examples(cli):
     for cmd in ("simulate", "plan", "focus", "interfere", "coherence", "polarimetry"):
         r = cli("gbsar", cmd, "--help")
         assert r.exit_code == 0 and "Examples:" in r.stdout, cmd
+
+
+def test_simulate_warns_beyond_r_max(cli, tmp_path):
+    p = _scene(tmp_path, "far", extra="[[points]]\nx_m = 0.0\ny_m = 80.0\n")  # R_max = 75 m here
+    r = cli("gbsar", "simulate", p, "-o", tmp_path / "far.h5", "--json")
+    assert r.exit_code == 0 and json.loads(r.stdout)["n_beyond_r_max"] == 1 and "fold back" in r.stderr
+    r = cli("gbsar", "simulate", tmp_path / "nope.toml", "-o", tmp_path / "x.h5")
+    assert r.exit_code != 0 and r.stderr.startswith("sarcli: error:")
