@@ -3,32 +3,39 @@
 Input (:class:`SlowTime`): the slow-time signals of the mover's range bin in channel 0 (the
 monostatic channel, receiver on the transmitter, range history R(eta) of
 :mod:`sarcli.ati.geometry`) and channel 1 (receiver ``d`` along-track, already co-registered by
-``d/(2*Vp)``), the slow times ``eta`` (s from the reference time), the mover's closest-approach
-range ``r_min`` from its range position (m) and the platform.
+``d/(2*Vp)``), the slow times ``eta`` (s from the reference time), the mover's tracked range
+position in the RCMC'd data ``r_track(eta)`` (m) and the platform.
+
+Range position after RCMC: the RDA moves the energy at Doppler f = -2R'/lam from range R to
+``R*D``, D = sqrt(1 - (R'/Vp)^2) (a stationary point's R*D is its closest range, exactly), so a mover
+is seen at ``r_track = R(eta)*sqrt(1 - R'(eta)^2/Vp^2)``. With R' and R - R(eta_m) known from the phase
+fit, the weighted mean of ``r_track`` fixes the absolute range rho = R(eta_m) (linear in rho). This
+holds whether or not the mover's closest approach lies inside the aperture (vy -> Vp included).
 
 Data reduced from the signals:
 - the unwrapped phase psi0(eta) of channel 0: R(eta) = -lam/(4*pi)*psi0(eta) + const (the constant
-  is lost to the 2*pi ambiguity, so absolute range comes only from ``r_min``);
+  is lost to the 2*pi ambiguity, so absolute range comes only from ``r_track``);
 - the ATI phase history phi(eta) = arg(s1*conj(s0)) = (4*pi/lam)*(d/(2*Vp))*vm(eta) - bistatic term,
   with vm(eta) the mover-induced range rate (see geometry.py) and the bistatic term
   (4*pi/lam)*d**2/(8*R) (half-sum of transmit and receive ranges exceeds the phase-centre range).
 
 Routes (knob ``route``):
 ``seed``      the paper's chain with the printed typos fixed: quadratic LS at eta = 0 -> vR, aR;
-              R0 = r_min; vx = vr_los*R0/x0 from the mean ATI phase (neglects vy*y/R over the
+              R0 = mean r_track; vx = vr_los*R0/x0 from the mean ATI phase (neglects vy*y/R over the
               aperture, as the paper does); vy = Vp - sqrt(R0*aR - vx^2) (eq. 15 with aR the full
               second derivative; drops vR^2); azimuth angle phi = (vR/cos_g)/(vy - Vp) (eq. 17 with
               cos_g = ground/slant range = sin(look), the printed cos(theta) uses an angle from the
               horizontal) and x0 = R0*cos_g, y0 = R0*cos_g*phi (eq. 18-19, small angle; neglects
               the vx*x0 term of vR).
-``exact``     (default) closed-form exact geometry: quadratic WLS at the weighted centre eta_m of the
-              data -> R'(eta_m), R''(eta_m); with r_min the hyperbola R^2 = r_min^2 + V2*(eta-eta_c)^2
-              follows exactly (R*R'' + R'^2 = V2, R^2 - (R*R')^2/V2 = r_min^2); R0, vR at eta = 0;
-              vm(0) from a quadratic fit of the ATI phase history; then y0 = R0*(vm - vR)/Vp (since
-              vR - vm = vs = -y0*Vp/R0), x0 = sqrt(R0^2 - H^2 - y0^2) on the look side, and vx, vy
-              from vR*R0 = vx*x0 + (vy - Vp)*y0 and vx^2 + (vy - Vp)^2 = V2.
+``exact``     (default) closed-form exact geometry: polynomial WLS at the weighted centre eta_m of
+              the data -> R'(eta_m), R''(eta_m); rho = R(eta_m) from r_track; V2 = rho*R'' + R'^2
+              (exact: R*R'' + R'^2 = V2 for straight-line motion); vm(eta_m) from a quadratic fit of
+              the ATI phase history; the along-track separation Y = rho*(vm - R')/Vp (since
+              R' - vm = vs = -Vp*Y/R), the ground distance X = sqrt(rho^2 - H^2 - Y^2) on the look
+              side, vx, vy from R'*rho = vx*X + (vy - Vp)*Y and vx^2 + (vy - Vp)^2 = V2, and finally
+              x0, y0, R0, vR, aR at eta = 0.
 ``nonlinear`` full weighted nonlinear LS of the exact (bistatic) range histories of both channels
-              to psi0(eta), phi(eta) and r_min, started from ``exact``.
+              to psi0(eta), phi(eta) and mean r_track, started from ``exact``.
 Every route returns 1-sigma uncertainties (propagated covariance, inflated by the reduced
 chi-square when the residuals exceed the noise model). vy is taken below Vp (a mover faster than the
 platform along-track is indistinguishable); when V2 <= vx^2 (vy -> Vp) the square root is clamped to
@@ -62,8 +69,8 @@ class SlowTime:
     eta: np.ndarray
     s0: np.ndarray
     s1: np.ndarray
-    r_min: float
-    r_min_sigma: float
+    r_track: np.ndarray
+    r_sigma: float
     platform: Platform
     baseline_m: float
     look_sign: float = 1.0
@@ -107,14 +114,15 @@ class _Reduced:
     phi: np.ndarray
     w_ati: np.ndarray
     sigma2: float
+    r_mean: float
 
 
 def _reduce(obs: SlowTime, unwrap_method: str) -> _Reduced:
     eta = np.asarray(obs.eta, np.float64)
     s0 = np.asarray(obs.s0, np.complex128)
     s1 = np.asarray(obs.s1, np.complex128)
-    if eta.shape != s0.shape or s0.shape != s1.shape or eta.size < 8:
-        raise SarcliError("slow-time signals must be 1-D, of equal length >= 8")
+    if eta.shape != s0.shape or s0.shape != s1.shape or np.shape(obs.r_track) != eta.shape or eta.size < 8:
+        raise SarcliError("slow-time signals and range track must be 1-D, of equal length >= 8")
     chirp = dominant_chirp(s0, eta)
     psi0 = unwrap(s0, eta, unwrap_method, chirp)
     model = chirp_phase(eta, chirp)
@@ -129,28 +137,16 @@ def _reduce(obs: SlowTime, unwrap_method: str) -> _Reduced:
     with np.errstate(divide="ignore", invalid="ignore"):
         w_ati = np.where((w0 > 0) & (w1 > 0), 1.0 / (1.0 / np.maximum(w0, 1e-300) + 1.0 / np.maximum(w1, 1e-300)),
                          0.0)
-    return _Reduced(eta, psi0, w0, phi, w_ati, sigma2)
+    r = np.asarray(obs.r_track, np.float64)
+    ok = (w0 > 0) & np.isfinite(r)
+    if not ok.any():
+        raise SarcliError("no slow-time sample carries the mover's signal")
+    return _Reduced(eta, psi0, w0, phi, w_ati, sigma2, float(np.average(r[ok], weights=w0[ok])))
 
 
 def _bistatic_phase(r: float, obs: SlowTime) -> float:
     """ATI phase (rad) of the transmit/receive half-sum excess d^2/(8R) (channel 1 minus 0)."""
     return -4.0 * np.pi / obs.platform.wavelength * obs.baseline_m ** 2 / (8.0 * r)
-
-
-def _hyperbola(b1: float, b2: float, r_min: float) -> tuple[float, float, float]:
-    """(rho = R(eta_m), V2, eta_m - eta_c) from R'(eta_m) = b1, R''(eta_m) = b2 and r_min."""
-    if b2 <= 0:
-        raise SarcliError("fitted range curvature is not positive: no mover signal in this range bin")
-    rho = r_min
-    for _ in range(50):
-        g = rho ** 3 * b2 - r_min ** 2 * (rho * b2 + b1 * b1)
-        dg = 3.0 * rho * rho * b2 - r_min ** 2 * b2
-        step = g / dg
-        rho -= step
-        if abs(step) < 1e-10 * r_min:
-            break
-    v2 = rho * b2 + b1 * b1
-    return rho, v2, rho * b1 / v2
 
 
 def _solve_velocities(r0: float, vr: float, y0: float, x0: float, v2: float, vp: float
@@ -175,17 +171,27 @@ def _ground(r0: float, obs: SlowTime) -> float:
     return g2
 
 
-def _exact_map(x: np.ndarray, obs: SlowTime, eta_m: float) -> np.ndarray:
-    """(b1, b2, r_min, phi_m) at eta_m -> (vx, vy, x0, y0, R0, vR, aR, degenerate) at eta = 0.
+def _rho(b1: float, b2: float, r_mean: float, fit: tuple, vp: float) -> float:
+    """R(eta_m) from the weighted mean tracked range: mean(r) = rho*mean(D) + mean(dR*D)."""
+    tau, w, c3, c4 = fit
+    dr = b1 * tau + 0.5 * b2 * tau ** 2 + c3 * tau ** 3 + c4 * tau ** 4
+    rdot = b1 + b2 * tau + 3.0 * c3 * tau ** 2 + 4.0 * c4 * tau ** 3
+    d = np.sqrt(np.maximum(1.0 - (rdot / vp) ** 2, 1e-12))
+    return float((r_mean - np.average(dr * d, weights=w)) / np.average(d, weights=w))
+
+
+def _exact_map(x: np.ndarray, obs: SlowTime, eta_m: float, fit: tuple) -> np.ndarray:
+    """(b1, b2, mean r_track, phi_m) -> (vx, vy, x0, y0, R0, vR, aR, degenerate) at eta = 0.
 
     At eta_m: rho = R, b1 = R', b2 = R''; vm = mover-induced range rate from the ATI phase phi_m;
     the along-track separation Y = y_target - y_platform obeys vs = R' - vm = -Vp*Y/rho, the ground
     distance X^2 = rho^2 - H^2 - Y^2, then vx, u from b1*rho = vx*X + u*Y and vx^2 + u^2 = V2;
     finally x0 = X - vx*eta_m, y0 = Y - u*eta_m.
     """
-    b1, b2, r_min, phi_m = x
+    b1, b2, r_mean, phi_m = x
     p = obs.platform
-    rho, v2, _ = _hyperbola(b1, b2, r_min)
+    rho = _rho(b1, b2, r_mean, fit, p.speed)
+    v2 = rho * b2 + b1 * b1
     vm = float(los_rate_from_phase(phi_m - _bistatic_phase(rho, obs), obs.baseline_m, p))
     y = rho * (vm - b1) / p.speed
     g2 = _ground(rho, obs)
@@ -200,7 +206,7 @@ def _exact_map(x: np.ndarray, obs: SlowTime, eta_m: float) -> np.ndarray:
 
 
 def _seed_map(x: np.ndarray, obs: SlowTime) -> np.ndarray:
-    """(vR, aR, r_min, mean ATI phase) -> (vx, vy, x0, y0, R0, vR, aR, degenerate), paper's chain."""
+    """(vR, aR, mean r_track, mean ATI phase) -> (vx, vy, x0, y0, R0, vR, aR, degenerate), paper's chain."""
     vr, ar, r0, phi = x
     p = obs.platform
     cos_g = math.sqrt(_ground(r0, obs)) / r0
@@ -251,27 +257,29 @@ def estimate(obs: SlowTime, route: str = "exact", unwrap_method: str = "dechirp"
              "unwrap": unwrap_method}
     if route == "seed":
         q = _fit.wls_poly(red.eta, rng, w_rng, 2, clip=CLIP)
-        # phase mean with the bistatic term of the seed's R0 (= r_min) removed inside _seed_map
-        x = np.array([q.coef[1], 2.0 * q.coef[2], obs.r_min, phi_mean])
+        x = np.array([q.coef[1], 2.0 * q.coef[2], red.r_mean, phi_mean])
         cx = np.zeros((4, 4))
         cx[0:2, 0:2] = q.cov[1:3, 1:3] * np.array([[1.0, 2.0], [2.0, 4.0]])
-        cx[2, 2] = obs.r_min_sigma ** 2
+        cx[2, 2] = obs.r_sigma ** 2
         cx[3, 3] = phi_sd ** 2
         y, cov = _fit.propagate(lambda v: _seed_map(v, obs), x, cx)
         return _finish(route, y, cov, obs, phi_mean, q.chi2_red, extra)
     eta_m = float(np.average(red.eta, weights=red.w0 + 1e-300))
     q = _fit.wls_poly(red.eta - eta_m, rng, w_rng, degree, clip=CLIP)
     qa = _fit.wls_poly(red.eta - eta_m, red.phi, red.w_ati, 2, clip=CLIP)
-    x = np.array([q.coef[1], 2.0 * q.coef[2], obs.r_min, qa.coef[0]])
+    x = np.array([q.coef[1], 2.0 * q.coef[2], red.r_mean, qa.coef[0]])
     cx = np.zeros((4, 4))
     cx[0:2, 0:2] = q.cov[1:3, 1:3] * np.array([[1.0, 2.0], [2.0, 4.0]])
-    cx[2, 2] = obs.r_min_sigma ** 2
+    cx[2, 2] = obs.r_sigma ** 2
     cx[3, 3] = qa.cov[0, 0]
-    y, cov = _fit.propagate(lambda v: _exact_map(v, obs, eta_m), x, cx)
+    hi = np.r_[q.coef, 0.0, 0.0]
+    use = red.w0 > 0
+    fit = (red.eta[use] - eta_m, red.w0[use], hi[3], hi[4])
+    y, cov = _fit.propagate(lambda v: _exact_map(v, obs, eta_m, fit), x, cx)
     chi2 = max(q.chi2_red, qa.chi2_red)
     if route == "exact":
         return _finish(route, y, cov, obs, phi_mean, chi2, extra)
     from sarcli.ati.nonlinear import fit_exact_history
 
-    y, cov, chi2 = fit_exact_history(obs, red.eta, red.psi0, red.w0, red.phi, red.w_ati, y)
+    y, cov, chi2 = fit_exact_history(obs, red.eta, red.psi0, red.w0, red.phi, red.w_ati, red.r_mean, y)
     return _finish(route, y, cov, obs, phi_mean, chi2, extra)

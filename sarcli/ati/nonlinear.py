@@ -6,15 +6,13 @@ models (see :mod:`sarcli.ati.estimate` for the reduction):
     psi0(eta) = -(4*pi/lam)*R(eta) + c                 R exact, :func:`geometry.range_history`
     phi(eta)  = -(4*pi/lam)*(R1(eta) - R(eta))         R1 = channel 1 co-registered by d/(2*Vp):
               R1(eta) = (|r1(eta-D) - r2(eta-D)| + |r1(eta-D) + (0, d, 0) - r2(eta-D)|)/2, D = d/(2*Vp)
-    r_min     = sqrt(R0^2 - (R0*vR)^2/V2)              closest-approach range of the trajectory
+    mean r_track = weighted mean of R*sqrt(1 - R'^2/Vp^2)     range position after RCMC (estimate.py)
 
 weighted by the inverse variances; solved by scipy's Levenberg-Marquardt. The covariance is
 ``(J^T J)^-1`` scaled by ``max(1, chi2_red)``.
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -42,7 +40,7 @@ def _derived(q: np.ndarray, obs) -> np.ndarray:
 
 
 def fit_exact_history(obs, eta: np.ndarray, psi0: np.ndarray, w0: np.ndarray, phi: np.ndarray,
-                      w_ati: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+                      w_ati: np.ndarray, r_mean: float, start: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Refine ``start`` = (vx, vy, x0, y0, ...) -> (values, covariance, chi2_red) as in estimate.py."""
     k = 4.0 * np.pi / obs.platform.wavelength
     use = (w0 > 0) | (w_ati > 0)
@@ -52,13 +50,16 @@ def fit_exact_history(obs, eta: np.ndarray, psi0: np.ndarray, w0: np.ndarray, ph
     r_start, _ = _histories(np.r_[q0, 0.0], eta, obs)
     c0 = float(np.average(psi0 + k * r_start, weights=w0[use] + 1e-300))
 
+    wr = w0[use] + 1e-300
+    vp = obs.platform.speed
+
     def resid(q: np.ndarray) -> np.ndarray:
         r, r1 = _histories(q, eta, obs)
-        d = _derived(q, obs)
-        v2 = q[0] ** 2 + (q[1] - obs.platform.speed) ** 2
-        rmin = math.sqrt(max(d[4] ** 2 - (d[4] * d[5]) ** 2 / v2, 0.0)) if v2 > 0 else d[4]
+        u = q[1] - vp
+        rdot = ((q[2] + q[0] * eta) * q[0] + (q[3] + u * eta) * u) / r
+        r_img = float(np.average(r * np.sqrt(np.maximum(1.0 - (rdot / vp) ** 2, 1e-12)), weights=wr))
         return np.concatenate([s0 * (psi0 - (-k * r + q[4])), sa * (phi + k * (r1 - r)),
-                               [(rmin - obs.r_min) / obs.r_min_sigma]])
+                               [(r_img - r_mean) / obs.r_sigma]])
 
     q_init = np.r_[q0, c0]
     scale = np.array([0.1, 0.1, 1.0, 1.0, 0.1])

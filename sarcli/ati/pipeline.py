@@ -22,7 +22,7 @@ import numpy as np
 from sarcli.ati.detect import Candidate, CfarKnobs, bistatic_phase, detect
 from sarcli.ati.estimate import Estimate, SlowTime, estimate
 from sarcli.ati.geometry import Mover, Platform, coefficients, range_history, stationary_history
-from sarcli.ati.slowtime import choose_bin, coregister, decompress, peak_range, recompress, track_peak
+from sarcli.ati.slowtime import choose_bin, coregister, decompress, recompress, single_bin, track_peak
 from sarcli.errors import SarcliError
 from sarcli.io.raw import RawProduct
 
@@ -138,15 +138,16 @@ def slow_time(pair: Pair, c: Candidate, bin_mode: str = "track") -> tuple[SlowTi
     ranges = np.asarray(pair.slc0.slant_range)[cols]
     phi_c = bistatic_phase(ranges, pair.baseline_m, pair.platform.wavelength)
     n0 = choose_bin(s1 - s0 * np.exp(1j * phi_c)[None, :])
-    r_min, r_sd = peak_range(s0, ranges)
-    if bin_mode == "track":
-        a0, a1 = track_peak(s0, n0), track_peak(s1, n0)
-    else:
-        a0, a1 = s0[:, n0], s1[:, n0]
+    pick = track_peak if bin_mode == "track" else single_bin
+    a0, pos = pick(s0, n0)
+    a1, _ = pick(s1, n0)
+    dr = float(ranges[1] - ranges[0])
+    r_track = ranges[0] + pos * dr
     eta = np.asarray(pair.slc0.azimuth_time, np.float64) - pair.t_ref
     shift = int(pair.slc0.parameters.get("shift_lines", 0))
     eta = eta + shift / float(pair.slc0.parameters.get("prf_hz", pair.slc0.prf_hz))
-    obs = SlowTime(eta, a0, a1, r_min, r_sd, pair.platform, pair.baseline_m, pair.look_sign)
+    # 1-sigma of the mean tracked range: quantization bound dr/sqrt(12) (conservative)
+    obs = SlowTime(eta, a0, a1, r_track, dr / math.sqrt(12.0), pair.platform, pair.baseline_m, pair.look_sign)
     return obs, rows, cols, s0
 
 
@@ -176,32 +177,41 @@ def compensation_phase(eta: np.ndarray, e: Estimate, platform: Platform, method:
     return k * (vm * eta + 0.5 * c.am * eta * eta)
 
 
-def _range_shift(block: np.ndarray, shift_m: float, spacing_m: float) -> np.ndarray:
-    """Shift columns by ``shift_m`` (positive = to larger range) with a zero-padded FFT."""
+def _range_shift(block: np.ndarray, shift_m: np.ndarray, spacing_m: float) -> np.ndarray:
+    """Shift each row of ``block`` by ``shift_m[row]`` (positive = to larger range) with a
+    zero-padded FFT along range."""
     n = block.shape[1]
-    nf = 2 * n
-    f = np.fft.fftfreq(nf)
-    buf = np.zeros((block.shape[0], nf), np.complex128)
+    f = np.fft.fftfreq(2 * n)
+    buf = np.zeros((block.shape[0], 2 * n), np.complex128)
     buf[:, :n] = block
-    out = np.fft.ifft(np.fft.fft(buf, axis=1) * np.exp(-2j * np.pi * f * shift_m / spacing_m)[None, :], axis=1)
-    return out[:, :n]
+    ramp = np.exp(-2j * np.pi * f[None, :] * (np.asarray(shift_m, np.float64)[:, None] / spacing_m))
+    return np.fft.ifft(np.fft.fft(buf, axis=1) * ramp, axis=1)[:, :n]
 
 
 def compensate(pair: Pair, res: MoverResult, method: str = "exact") -> np.ndarray:
     """Channel-0 image with the mover's smear replaced by its compensated, re-compressed image at its
-    true position (azimuth y0, range sqrt(x0^2 + H^2))."""
+    true position (azimuth y0, range sqrt(x0^2 + H^2)).
+
+    Before the phase correction each slow-time row is moved in range from where the RCMC left the
+    mover, R*sqrt(1 - R'^2/Vp^2) (estimate.py), to the stationary equivalent's closest range, so
+    the re-compressed mover is one column wide like a stationary point (no residual migration).
+    """
     rows, cols = res.rows, res.cols
     s0 = decompress(pair.slc0, pair.z0, rows, cols)
     eta = np.asarray(pair.slc0.azimuth_time, np.float64) - pair.t_ref
     shift = int(pair.slc0.parameters.get("shift_lines", 0))
     eta = eta + shift / float(pair.slc0.parameters.get("prf_hz", pair.slc0.prf_hz))
-    h = np.exp(1j * compensation_phase(eta, res.estimate, pair.platform, method))
-    sub = recompress(pair.slc0, s0 * h[:, None], cols)
     e = res.estimate
+    p = pair.platform
+    m = Mover(e.x0_m, e.y0_m, e.vx_mps, e.vy_mps)
+    r = range_history(eta, m, p)
+    rdot = ((m.x0 + m.vx * eta) * m.vx + (m.y0 + (m.vy - p.speed) * eta) * (m.vy - p.speed)) / r
+    r_img = r * np.sqrt(np.maximum(1.0 - (rdot / p.speed) ** 2, 0.0))
+    r_stat = math.sqrt(e.x0_m ** 2 + p.height ** 2)
     ranges = np.asarray(pair.slc0.slant_range)
-    r_stat = math.sqrt(e.x0_m ** 2 + pair.platform.height ** 2)
-    obs_r, _ = peak_range(s0, ranges[cols])
-    sub = _range_shift(sub, r_stat - obs_r, float(ranges[1] - ranges[0]))
+    s0 = _range_shift(s0, r_stat - r_img, float(ranges[1] - ranges[0]))
+    h = np.exp(1j * compensation_phase(eta, e, p, method))
+    sub = recompress(pair.slc0, s0 * h[:, None], cols)
     out = pair.z0.astype(np.complex64, copy=True)
     out[rows, cols] = 0.0
     out[:, cols] += sub.astype(np.complex64)

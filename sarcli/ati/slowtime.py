@@ -111,8 +111,9 @@ def choose_bin(slow: np.ndarray, min_power_fraction: float = 0.1) -> int:
     return int(np.argmin(v))
 
 
-def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4) -> np.ndarray:
-    """Per row, the sample of largest magnitude within ``col +- halfwidth`` (range tracking).
+def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Per row, the sample of largest magnitude within ``col +- halfwidth`` (range tracking), and its
+    fractional column (parabolic interpolation of the magnitude).
 
     A mover's range history differs from the stationary one the RCMC assumes, so it drifts by a
     few range bins over a long aperture (R'^2*R*(1/V^2 - 1/Vp^2)/2, ~2.4 m at the start of the
@@ -122,20 +123,17 @@ def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4) -> np.ndarray:
     """
     a, b = max(0, col - halfwidth), min(slow.shape[1], col + halfwidth + 1)
     blk = slow[:, a:b]
-    k = np.argmax(np.abs(blk), axis=1)
-    return blk[np.arange(blk.shape[0]), k]
+    mag = np.abs(blk)
+    k = np.argmax(mag, axis=1)
+    rows = np.arange(blk.shape[0])
+    km, kp = np.clip(k - 1, 0, blk.shape[1] - 1), np.clip(k + 1, 0, blk.shape[1] - 1)
+    y0, y1, y2 = mag[rows, km], mag[rows, k], mag[rows, kp]
+    den = y0 - 2.0 * y1 + y2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        off = np.where((den < 0) & (km != k) & (kp != k), 0.5 * (y0 - y2) / den, 0.0)
+    return blk[rows, k], a + k + off
 
 
-def peak_range(slow: np.ndarray, ranges: np.ndarray) -> tuple[float, float]:
-    """(range of the power peak, its 1-sigma) from the row-summed power profile, parabolic
-    interpolation on the three samples around the maximum; sigma = spacing/sqrt(12) (quantization
-    bound), at least the offset between the parabola and the strongest sample's neighbours' mean."""
-    p = np.sum(np.abs(slow) ** 2, axis=0)
-    i = int(np.argmax(p))
-    dr = float(ranges[1] - ranges[0]) if ranges.size > 1 else 1.0
-    if 0 < i < p.size - 1:
-        den = p[i - 1] - 2.0 * p[i] + p[i + 1]
-        off = 0.5 * (p[i - 1] - p[i + 1]) / den if den < 0 else 0.0
-    else:
-        off = 0.0
-    return float(ranges[i] + off * dr), dr / np.sqrt(12.0)
+def single_bin(slow: np.ndarray, col: int) -> tuple[np.ndarray, np.ndarray]:
+    """The seed's choice: one range bin for all rows (signal and its constant column)."""
+    return slow[:, col], np.full(slow.shape[0], float(col))

@@ -17,8 +17,8 @@ P = Platform(10e3, 2000.0, 299792458.0 / 1e9)
 
 
 def _obs(synth, **kw):
-    eta, s0, s1, r_min = synth(**kw)
-    return SlowTime(eta, s0, s1, r_min, 0.1, P, kw.get("d", 2.0))
+    eta, s0, s1, r_track = synth(**kw)
+    return SlowTime(eta, s0, s1, r_track, 0.1, P, kw.get("d", 2.0))
 
 
 def _rel(e, truth):
