@@ -65,9 +65,11 @@ def focus_df(prof: RangeProfiles, n_xfft: int | None = None, azimuth_window: str
     r = prof.ranges_m
     w = stop_weights(prof, azimuth_window)
     with np.errstate(divide="ignore", invalid="ignore"):
-        deramp = np.exp(1j * 2 * np.pi * x[:, None] ** 2 / (lam * r[None, :]))
-    deramp[:, r <= 0] = 0.0  # r = 0: no deramp defined, no image
-    a = (prof.data * deramp * (w / w.sum())[:, None]).astype(np.complex64)
+        phase = (2 * np.pi / lam * x[:, None] ** 2 / r[None, :]).astype(np.float32)  # < 2e3 rad: float32 ok
+    phase[:, r <= 0] = 0.0
+    a = prof.data * np.exp(1j * phase)  # complex64 throughout: the paper's 8-byte samples
+    a *= (w / w.sum()).astype(np.float32)[:, None]
+    a[:, r <= 0] = 0.0  # r = 0: no deramp defined, no image
     g = scipy.fft.fft(a, n=n, axis=0)  # (n_u, n_r), kernel exp(-j 2 pi k i / n)
     u = scipy.fft.fftfreq(n, dx)
     g *= np.exp(-2j * np.pi * u * x[0])[:, None].astype(np.complex64)  # x_i = x_0 + i dx

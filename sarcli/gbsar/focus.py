@@ -21,7 +21,7 @@ from sarcli.gbsar.backprojection import backproject
 from sarcli.gbsar.deramp import focus_df, geometric_correction
 from sarcli.gbsar.rangecomp import RangeProfiles, range_compress
 from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
-from sarcli.gbsar.system import df_min_range, next_pow2
+from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
 from sarcli.io.scan import Scan
 
 ALGORITHMS = ("auto", "df", "rd", "bp")
@@ -181,6 +181,12 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     }
     if opts.algorithm == "auto" and not uniform:
         report["note"] = "non-uniform rail steps: DF/RD impossible, the whole image was backprojected"
+    df_ranges = grid.ranges[alg_plan["df"]] if "df" in alg_plan else np.zeros(0)
+    if df_ranges.size and df_ranges[0] < split:  # DF asked to image nearer than eq. 12 allows
+        r_low = float(df_ranges[df_ranges > 0][0]) if np.any(df_ranges > 0) else split
+        err = df_phase_error(prof0.wavelength_m, r_low, prof0.wavelength_m * r_low / (2 * lx), rail / 2)
+        report["df_below_limit"] = {"from_m": float(df_ranges[0]), "limit_m": split,
+                                    "eq11_phase_error_rad": float(err)}
     return Focused(image=image, grid=grid, algorithm_map=amap, report=report)
 
 

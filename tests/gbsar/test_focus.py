@@ -283,3 +283,11 @@ def test_geometric_correction_kernel_matches_numpy_reference():
     b, cb = geometric_correction_reference(img, ranges, az, 0.0566)
     np.testing.assert_array_equal(ca, cb)
     np.testing.assert_allclose(a, b, atol=2e-4)
+
+
+def test_df_below_its_limit_is_reported():
+    s = scan_of([(0.0, 5.0)], rail=4.0)
+    f = focus_scan(s, FocusOptions(algorithm="df", max_range_m=15.0))
+    b = f.report["df_below_limit"]
+    assert b["limit_m"] == pytest.approx(df_min_range(LAM, 4.0, 0.25)) and b["eq11_phase_error_rad"] > np.pi / 4
+    assert "df_below_limit" not in focus_scan(s, FocusOptions(algorithm="auto", max_range_m=15.0)).report

@@ -188,6 +188,10 @@ def focus_cmd(
     f = img
     write_gbsar_image(output, img, parameters=vars(opts), inputs=[scan])
     _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quicklook, f.report)
+    if "df_below_limit" in f.report:
+        b = f.report["df_below_limit"]
+        info(f"warning: DF used from {b['from_m']:.2f} m, below its minimum range {b['limit_m']:.2f} m (eq. 12): "
+             f"phase error up to {b['eq11_phase_error_rad']:.2f} rad, near-range targets defocus")
     if f.report["skipped_stops"]:
         info(f"warning: skipped {len(f.report['skipped_stops'])} flagged/NaN stop(s): {f.report['skipped_stops']}")
     if json_out:
