@@ -8,11 +8,13 @@ scatterer costs (pulses in beam) x 2 grid updates, plus one FFT convolution per 
     out[n] = (grid * c_q)[q n + 2M],  c_q[j] = exp(j pi K (j/(q fs))^2) for |j| <= M,
 
 with the chirp spectrum divided by sinc^2(nu) (nu = frequency / (q fs)) to undo the triangular
-splatting kernel. The carrier phase of every scatterer and pulse is exact; what remains is the
-aliasing of the splat, sinc^2(1 - nu_max)/sinc^2(nu_max) relative, nu_max = B/(2 q fs): about -35 dB
-at q = 4 and -48 dB at q = 8 for a 0.93 fs bandwidth (measured against the exact kernel in the
-tests and the benchmark). Knob: [scene] clutter_oversampling (default 8); clutter_model = "exact"
-sends clutter through the exact kernel instead.
+splatting kernel. The carrier phase of every scatterer and pulse is exact. Errors: the splat's
+aliasing, sinc^2(1 - nu_max)/sinc^2(nu_max) with nu_max = B/(2 q fs) (-35 dB at q = 4, -48 dB at
+q = 8 for B = 0.93 fs), and the rectangular pulse edges, which land on the q-grid instead of at the
+exact sub-sample delay. Measured against the exact kernel (tests, benchmark): -31 dB (q = 4) and
+-37 dB (q = 8) relative error energy, i.e. the edges dominate. Knob: [scene] clutter_oversampling
+(default 4: speckle-level error, half the FFT cost of 8); clutter_model = "exact" sends clutter
+through the exact kernel instead.
 """
 
 from __future__ import annotations

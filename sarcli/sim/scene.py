@@ -217,7 +217,7 @@ class Scene:
     clutter: list[ClutterPatch] = field(default_factory=list)
     reference_height_m: float = 0.0
     clutter_model: str = "binned"
-    clutter_oversampling: int = 8
+    clutter_oversampling: int = 4
 
     def has(self, effect: str) -> bool:
         return effect in self.effects
@@ -350,7 +350,7 @@ def parse_scene(text: str, src: str = "<scene>") -> Scene:
     center = st.num("center_time_s", 0.0)
     ref_h = st.num("reference_height_m", 0.0)
     clutter_model = st.str("clutter_model", "binned", ("binned", "exact"))
-    clutter_q = st.int("clutter_oversampling", 8, minimum=2)
+    clutter_q = st.int("clutter_oversampling", 4, minimum=2)
     st.used.add("effects")
     effects = st.data.get("effects", [])
     if not isinstance(effects, list) or not all(isinstance(x, str) for x in effects):

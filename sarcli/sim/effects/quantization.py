@@ -33,7 +33,7 @@ def quantize(u: np.ndarray, bits: int) -> np.ndarray:
     top = 2**bits - 1
 
     def q(a):
-        return np.clip(2.0 * np.floor(a / 2.0) + 1.0, -top, top)
+        return np.clip(2 * np.floor(a * np.float32(0.5)) + 1, -top, top)
 
     return (q(u.real) + 1j * q(u.imag)).astype(np.complex64)
 
@@ -56,7 +56,7 @@ def apply(ctx, params, product):
     g_db = float(np.round(center - 20.0 * np.log10(np.median(lit) / rms))) if lit.size else 0.0
     gain = 10.0 ** (g_db / 20.0)
     a = agc_db(sigma, gain, rms)
-    scale = (gain * 10.0 ** (-a / 20.0))[:, None]
+    scale = (gain * 10.0 ** (-a / 20.0)).astype(np.float32)[:, None]  # float32: no complex128 temporaries
     product.echo = quantize(product.echo * scale, bits)
     if product.echo_channels is not None:
         product.echo_channels = quantize(product.echo_channels * scale[None], bits)

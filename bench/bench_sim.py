@@ -1,0 +1,182 @@
+"""Stripmap simulator benchmark: numba echo kernel vs the vectorized numpy reference (same physics),
+and how the cost grows with targets, beam length, effects and clutter scatterers.
+
+Scenes are Radarsat-1-like (fine-beam timing, full 41.74 us pulse = 1349 samples unless stated).
+Throughput unit: "target-samples" = sum over targets of (pulses in beam) x (samples in the pulse).
+Timings are best-of-n after a warm-up call (numba compilation or cache load reported separately).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from numba import get_num_threads
+
+from bench.common import best_time, markdown_table, peak_rss_bytes, write_results
+from sarcli.sim.kernel import echo_kernel, echo_reference
+from sarcli.sim.scene import parse_scene
+from sarcli.sim.stripmap import _concat, kernel_args, prepare, simulate
+
+BASE = """
+[scene]
+name = "bench"
+seed = 1
+epoch_utc = "2002-06-16T15:41:00Z"
+effects = {effects}
+
+[radar]
+carrier_frequency_hz = 5.3e9
+prf_hz = 1256.9846363282768
+range_sampling_rate_hz = 32317075.0
+chirp_rate_hz_per_s = -0.72135e12
+pulse_length_s = {pulse}
+n_lines = {n_lines}
+n_samples = {n_samples}
+window_start_s = 0.006595629060396091
+
+[antenna]
+length_m = {length}
+height_m = 1.5
+look_angle_deg = 33.5
+
+[platform]
+type = "orbit"
+semi_major_axis_m = 7167100.0
+eccentricity = 0.00115
+inclination_deg = 98.594
+raan_deg = 20.0
+arg_perigee_deg = 90.0
+mean_anomaly_deg = -40.3
+
+[second_channel]
+receiver_offset_m = 5.0
+[noise]
+snr_db = 10.0
+[attitude]
+pitch_deg = 0.02
+
+{targets}
+"""
+
+
+def scene(n_targets=8, length=15.0, effects=("range_migration",), n_lines=2048, n_samples=2400,
+          pulse=41.74e-6, clutter=""):
+    rng = np.random.default_rng(0)
+    tg = "".join(f"[[targets]]\nslant_range_m = {r:.1f}\nazimuth_time_s = {a:.4f}\n"
+                 for r, a in zip(rng.uniform(992500, 996000, n_targets), rng.uniform(-0.15, 0.15, n_targets),
+                                 strict=True))
+    eff = "[" + ", ".join(f'"{e}"' for e in effects) + "]"
+    return parse_scene(BASE.format(effects=eff, pulse=pulse, n_lines=n_lines, n_samples=n_samples, length=length,
+                                   targets=tg + clutter), "bench.toml")
+
+
+def _kernel_inputs(sc):
+    ctx, traj, motion, axes, rot, points, clutter, _ = prepare(sc)
+    args = kernel_args(sc, ctx, traj, motion, axes, rot, _concat(points, clutter))
+    n_ch = len(ctx.receiver_offsets_m)
+    work = int(np.sum(args[10] - args[9])) * round(sc.radar.pulse_length_s * sc.radar.range_sampling_rate_hz) * n_ch
+    return args, n_ch, work
+
+
+def kernel_vs_numpy():
+    sc = scene(n_targets=8)
+    args, n_ch, work = _kernel_inputs(sc)
+    shape = (n_ch, sc.radar.n_lines, sc.radar.n_samples)
+    block = max(8, sc.radar.n_lines // (4 * get_num_threads()))
+    out = np.zeros(shape, np.complex64)
+    t_first = time.perf_counter()
+    echo_kernel(out, *args, block)
+    t_first = time.perf_counter() - t_first
+    t_nb = best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block), repeat=3)
+    t_np = best_time(lambda: echo_reference(np.zeros(shape, np.complex64), *args), repeat=1, warmup=0)
+    ref = np.zeros(shape, np.complex64)
+    echo_reference(ref, *args)
+    err = float(np.max(np.abs(ref - out)))
+    return {"targets": 8, "target_samples": work, "numba_s": t_nb, "numpy_s": t_np, "speedup": t_np / t_nb,
+            "numba_msamples_per_s": work / t_nb / 1e6, "numpy_msamples_per_s": work / t_np / 1e6,
+            "first_call_s": t_first, "max_abs_diff": err, "threads": get_num_threads()}
+
+
+def kernel_only(sc):
+    args, n_ch, work = _kernel_inputs(sc)
+    shape = (n_ch, sc.radar.n_lines, sc.radar.n_samples)
+    block = max(8, sc.radar.n_lines // (4 * get_num_threads()))
+    return best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block), repeat=3), work
+
+
+def main() -> None:
+    res: dict = {}
+    kv = kernel_vs_numpy()
+    res["kernel_vs_numpy"] = kv
+    md = ["# bench_sim: stripmap echo simulator\n",
+          f"numba threads: {kv['threads']}. Radarsat-1-like scene, 2048 lines x 2400 samples, 1349-sample pulse.\n",
+          "## Echo kernel vs vectorized numpy reference (same physics, 8 point targets)\n",
+          markdown_table(["target-samples", "numba s", "numpy s", "speedup", "numba Msamples/s", "numpy Msamples/s",
+                          "first call s (compile/cache)", "max |diff|"],
+                         [[kv["target_samples"], kv["numba_s"], kv["numpy_s"], kv["speedup"],
+                           kv["numba_msamples_per_s"], kv["numpy_msamples_per_s"], kv["first_call_s"],
+                           kv["max_abs_diff"]]])]
+
+    rows = []
+    for n in (1, 4, 16, 64):
+        t, work = kernel_only(scene(n_targets=n))
+        rows.append([n, work, t, work / t / 1e6])
+    res["targets"] = rows
+    md += ["\n## Cost vs number of targets (kernel only)\n",
+           markdown_table(["targets", "target-samples", "s", "Msamples/s"], rows)]
+
+    rows = []
+    for length in (30.0, 15.0, 7.5):
+        sc = scene(n_targets=8, length=length, n_lines=4096)
+        t, work = kernel_only(sc)
+        pulses = work / 8 / 1349
+        rows.append([length, round(pulses), t, work / t / 1e6])
+    res["beam_length"] = rows
+    md += ["\n## Cost vs beam length (8 targets, 4096 lines; antenna length sets the pulses in the beam)\n",
+           markdown_table(["antenna m", "pulses in beam", "s", "Msamples/s"], rows)]
+
+    rows = []
+    chain = ["range_migration", "antenna_pattern", "earth_rotation", "attitude", "chirp_replica", "noise",
+             "quantization", "second_channel"]
+    for k in range(0, len(chain) + 1):
+        eff = tuple(chain[:k])
+        if "second_channel" in eff:
+            eff = tuple(e for e in eff if e != "quantization")
+        sc = scene(n_targets=8, effects=eff)
+        t = best_time(lambda sc=sc: simulate(sc), repeat=2)
+        rows.append([" + ".join(eff) or "(none)", t])
+    res["effects"] = rows
+    md += ["\n## Whole `simulate()` vs effects listed (8 targets; second_channel replaces quantization: "
+           "CEOS-style 4-bit is one channel only in the demo, both are allowed)\n",
+           markdown_table(["effects", "s"], rows)]
+
+    rows = []
+    clutter = ("[[clutter]]\nslant_range_m = 992800.0\nazimuth_time_s = 0.0\nrange_extent_m = 1500.0\n"
+               "azimuth_extent_m = 6000.0\nsigma0_db = -10.0\ndensity_per_m2 = {d}\n")
+    for d in (0.0001, 0.001):
+        for model, q in (("exact", 0), ("binned", 4), ("binned", 8)):
+            if model == "exact" and d > 0.0005:
+                continue
+            sc = scene(n_targets=0, clutter=clutter.format(d=d), effects=("range_migration", "antenna_pattern"),
+                       n_samples=1800)
+            sc.clutter_model = model
+            if q:
+                sc.clutter_oversampling = q
+            t = best_time(lambda sc=sc: simulate(sc), repeat=1)
+            n = round(d * 1500 * 6000)
+            rows.append([n, model, q or "-", t, n / t])
+    res["clutter"] = rows
+    md += ["\n## Clutter: exact kernel vs binned (oversampled splat + FFT), full 1349-sample pulse, 2048 x 1800\n",
+           markdown_table(["scatterers", "model", "oversampling", "s", "scatterers/s"], rows),
+           "\nBinned accuracy vs exact (tests/sim/test_kernel.py): about -31 dB (q = 4) and -37 dB (q = 8) "
+           "relative error energy, dominated by the sub-sample position of the rectangular pulse edges. "
+           "The exact kernel costs (pulses in beam) x (pulse samples) per scatterer, the binned one "
+           "(pulses in beam) x 2 per scatterer plus one FFT convolution per line.\n"]
+    res["peak_rss_mb"] = peak_rss_bytes() / 1e6
+    md.append(f"\nPeak RSS: {res['peak_rss_mb']:.0f} MB\n")
+    write_results("bench_sim", "".join(md), res)
+
+
+if __name__ == "__main__":
+    main()
