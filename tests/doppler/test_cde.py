@@ -24,8 +24,9 @@ def test_kernel_matches_numpy_reference(n_lines, n_samples, az, rg, est, seed):
     h[rng.random(h.shape) < 0.1] = 0  # exact zeros: sign(0) = 0 in both
     a = block_correlation(h, az, rg, est)
     b = block_correlation_numpy(h, az, rg, est)
-    np.testing.assert_allclose(a.corr, b.corr, rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(a.energy, b.energy, rtol=1e-9, atol=1e-9)
+    # float32 sums over one line of a range block (<= 40 products here): ~1e-7 relative to the energy
+    assert np.all(np.abs(a.corr - b.corr) <= 1e-6 * b.energy + 1e-12)
+    np.testing.assert_allclose(a.energy, b.energy, rtol=1e-6, atol=1e-12)
     np.testing.assert_array_equal(a.pairs, b.pairs)
     assert a.n_lines.sum() == n_lines and a.n_samples.sum() == n_samples
 
