@@ -221,9 +221,28 @@ def _seed_map(x: np.ndarray, obs: SlowTime) -> np.ndarray:
     return np.array([vx, vy, x0, r0 * cos_g * az, r0, vr, ar, float(deg)])
 
 
+def _degenerate_vy_sigma(fn, x: np.ndarray, cx: np.ndarray) -> float:
+    """1-sigma of vy where the square root is clamped (vy -> Vp): the linearized propagation gives 0
+    there, so take half the largest change of vy over +-2 sigma steps of each input."""
+    sd = np.sqrt(np.maximum(np.diag(cx), 0.0))
+    vy0 = fn(x)[1]
+    worst = 0.0
+    for i in range(x.size):
+        for sgn in (-2.0, 2.0):
+            xp = x.copy()
+            xp[i] += sgn * sd[i]
+            try:
+                worst = max(worst, abs(fn(xp)[1] - vy0))
+            except SarcliError:
+                continue
+    return 0.5 * worst
+
+
 def _finish(route: str, y: np.ndarray, cov: np.ndarray, obs: SlowTime, phi_mean: float,
-            chi2: float, extra: dict) -> Estimate:
+            chi2: float, extra: dict, vy_sigma: float | None = None) -> Estimate:
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    if vy_sigma is not None:
+        sd[1] = max(sd[1], vy_sigma)
     vb = blind_speed(obs.baseline_m, obs.platform)
     phi_sd = extra.get("ati_phase_sigma_rad", 0.0)
     return Estimate(
@@ -263,7 +282,8 @@ def estimate(obs: SlowTime, route: str = "exact", unwrap_method: str = "dechirp"
         cx[2, 2] = obs.r_sigma ** 2
         cx[3, 3] = phi_sd ** 2
         y, cov = _fit.propagate(lambda v: _seed_map(v, obs), x, cx)
-        return _finish(route, y, cov, obs, phi_mean, q.chi2_red, extra)
+        vys = _degenerate_vy_sigma(lambda v: _seed_map(v, obs), x, cx) if y[7] > 0.5 else None
+        return _finish(route, y, cov, obs, phi_mean, q.chi2_red, extra, vys)
     eta_m = float(np.average(red.eta, weights=red.w0 + 1e-300))
     q = _fit.wls_poly(red.eta - eta_m, rng, w_rng, degree, clip=CLIP)
     qa = _fit.wls_poly(red.eta - eta_m, red.phi, red.w_ati, 2, clip=CLIP)
@@ -277,9 +297,10 @@ def estimate(obs: SlowTime, route: str = "exact", unwrap_method: str = "dechirp"
     fit = (red.eta[use] - eta_m, red.w0[use], hi[3], hi[4])
     y, cov = _fit.propagate(lambda v: _exact_map(v, obs, eta_m, fit), x, cx)
     chi2 = max(q.chi2_red, qa.chi2_red)
+    vys = _degenerate_vy_sigma(lambda v: _exact_map(v, obs, eta_m, fit), x, cx) if y[7] > 0.5 else None
     if route == "exact":
-        return _finish(route, y, cov, obs, phi_mean, chi2, extra)
+        return _finish(route, y, cov, obs, phi_mean, chi2, extra, vys)
     from sarcli.ati.nonlinear import fit_exact_history
 
     y, cov, chi2 = fit_exact_history(obs, red.eta, red.psi0, red.w0, red.phi, red.w_ati, red.r_mean, y)
-    return _finish(route, y, cov, obs, phi_mean, chi2, extra)
+    return _finish(route, y, cov, obs, phi_mean, chi2, extra, vys)

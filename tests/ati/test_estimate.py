@@ -66,11 +66,16 @@ def test_vx_zero_no_ati_phase(synth):
     assert abs(e.vy_mps - 50.0) / 50.0 < 0.002 and abs(e.y0_m - 500.0) < 2.0
 
 
-def test_vy_equal_platform_speed_is_flagged_not_nan(synth):
+@pytest.mark.parametrize("route", ["seed", "exact"])
+@pytest.mark.parametrize("y0", [0.0, 300.0])
+def test_vy_equal_platform_speed_is_flagged_not_nan(synth, route, y0):
     # relative along-track velocity zero: no azimuth chirp beyond vx^2/R; sqrt argument ~ 0
-    e = estimate(_obs(synth, vy=2000.0, vx=10.0, y0=0.0, snr_db=40.0), "seed")
+    e = estimate(_obs(synth, vy=2000.0, vx=10.0, y0=y0, snr_db=40.0), route)
     assert math.isfinite(e.vy_mps) and e.vy_degenerate
     assert abs(e.vy_mps - 2000.0) < 20.0
+    if route == "exact":                          # the geometry still gives the position
+        assert e.vy_mps_sigma > 0                 # from +-2 sigma steps, not the (zero) linear slope
+        assert abs(e.x0_m - 5095.3) < 1.0 and abs(e.y0_m - y0) < 1.0
 
 
 def test_mover_leaving_the_scene_uses_the_visible_part(synth, paper):
