@@ -139,13 +139,28 @@ def from_toml(path: str | Path) -> DesignParams:
     return validate(p, str(path))
 
 
+def doppler_bandwidth(echo: np.ndarray, prf_hz: float, energy: float = 0.99) -> float:
+    """Azimuth bandwidth (Hz) holding ``energy`` of the echo's azimuth power spectrum, centred on the
+    power centroid (the lag-1 phase, so squinted spaceborne data work too). It is what the antenna beam
+    illuminated: B_D = 2 v / D_equivalent."""
+    e = np.asarray(echo)
+    centroid = np.angle(np.sum(e[1:] * np.conj(e[:-1]))) / (2 * np.pi)  # cycles per line
+    spec = np.sum(np.abs(np.fft.fft(e, axis=0)) ** 2, axis=1)
+    f = np.fft.fftfreq(e.shape[0])
+    offset = np.abs((f - centroid + 0.5) % 1.0 - 0.5)  # circular distance from the centroid
+    order = np.argsort(offset)
+    cum = np.cumsum(spec[order]) / np.sum(spec)
+    return float(2.0 * offset[order][min(np.searchsorted(cum, energy), e.shape[0] - 1)] * prf_hz)
+
+
 def from_raw(path: str | Path) -> DesignParams:
-    """Design parameters of a stripmap raw product (height and speed from its orbit when present)."""
-    from sarcli.io.raw import raw_shape, read_raw
+    """Design parameters of a stripmap raw product (height and speed from its orbit when present; the
+    equivalent antenna length from the echo's Doppler bandwidth, on up to 4096 x 512 central samples)."""
+    from sarcli.io.raw import raw_shape, read_raw, read_raw_echo_block
 
     raw = read_raw(path, load_echo=False)
     r = raw.radar
-    n_samples = raw_shape(path)[1]
+    n_lines, n_samples = raw_shape(path)
     swath = n_samples * C_LIGHT / (2 * r.range_sampling_rate_hz)
     centre_range = r.first_range_m + swath / 2
     if raw.orbit is not None and raw.orbit.frame in ("ECI", "ECEF"):
@@ -167,7 +182,13 @@ def from_raw(path: str | Path) -> DesignParams:
         look_from = "horizontal"
     else:
         raise SarcliError(f"{path}: the product has no orbit; a design needs platform height and speed")
-    p = DesignParams(platform=platform, carrier_frequency_hz=r.carrier_frequency_hz,
+    a = max(0, n_lines // 2 - 2048)
+    c = max(0, n_samples // 2 - 256)
+    block = read_raw_echo_block(path, a, a + 4096)[:, c:c + 512]
+    if not np.any(block):
+        raise SarcliError(f"{path}: the echo is all zero; its Doppler bandwidth (antenna length) cannot be measured")
+    antenna = 2.0 * speed / doppler_bandwidth(block, r.prf_hz)
+    p = DesignParams(platform=platform, carrier_frequency_hz=r.carrier_frequency_hz, antenna_length_m=antenna,
                      chirp_rate_hz_per_s=r.chirp_rate_hz_per_s, pulse_length_s=r.pulse_length_s,
                      altitude_m=height, velocity_mps=speed, look_angle_deg=look, look_angle_from=look_from,
                      swath_slant_m=swath, slant_range_m=centre_range, prf_hz=[r.prf_hz],
@@ -193,13 +214,61 @@ def from_scan(path: str | Path) -> DesignParams:
     return validate(p, str(path))
 
 
+def from_stripmap_scene(path: str | Path) -> DesignParams:
+    """Design parameters of a ``sarcli simulate`` scene (the radar as simulated, swath = range window)."""
+    from sarcli.sim.scene import LinearPlatform, OrbitPlatform, load_scene
+
+    sc = load_scene(path)
+    r, ant, pl = sc.radar, sc.antenna, sc.platform
+    swath = r.n_samples * C_LIGHT / (2 * r.range_sampling_rate_hz)
+    centre = C_LIGHT * r.window_start_s / 2 + swath / 2
+    if isinstance(pl, LinearPlatform):
+        platform, height, speed = "airborne", pl.height_m, pl.velocity_mps
+    elif isinstance(pl, OrbitPlatform):
+        a = pl.elements.semi_major_axis_m
+        platform, height, speed = "spaceborne", a - WGS84_A, math.sqrt(3.986004418e14 / a)
+    else:
+        k = len(pl.time) // 2
+        platform = "spaceborne"
+        height = float(np.linalg.norm(pl.position[k])) - WGS84_A
+        speed = float(np.linalg.norm(pl.velocity[k]))
+    p = DesignParams(platform=platform, carrier_frequency_hz=r.carrier_frequency_hz,
+                     chirp_rate_hz_per_s=r.chirp_rate_hz_per_s, pulse_length_s=r.pulse_length_s,
+                     altitude_m=height, velocity_mps=speed, look_angle_deg=math.degrees(ant.look_angle_rad),
+                     look_angle_from="nadir", antenna_length_m=ant.length_m, swath_slant_m=swath,
+                     slant_range_m=centre, prf_hz=[r.prf_hz], source=Path(path).name)
+    return validate(p, str(path))
+
+
+def from_gbsar_scene(path: str | Path) -> DesignParams:
+    """Design parameters of a ``sarcli gbsar simulate`` scene."""
+    from sarcli.gbsar.scene import load_scene
+
+    sc = load_scene(path)
+    x = np.asarray(sc.positions_m)
+    p = DesignParams(platform="gbsar", carrier_frequency_hz=sc.center_frequency_hz,
+                     frequency_start_hz=sc.center_frequency_hz - sc.bandwidth_hz / 2,
+                     frequency_stop_hz=sc.center_frequency_hz + sc.bandwidth_hz / 2, n_frequencies=int(sc.points),
+                     rail_length_m=float(x[-1] - x[0]), rail_step_m=float(np.median(np.diff(x))),
+                     antenna_length_m=sc.antenna.length_azimuth_m,
+                     beamwidth_deg=math.degrees(sc.antenna.beamwidth_rad), antenna_height_m=sc.height_m,
+                     source=Path(path).name)
+    return validate(p, str(path))
+
+
 def load(path: str | Path) -> DesignParams:
-    """Design parameters from a design TOML, a raw product or a GB-SAR scan."""
+    """Design parameters from a design TOML, a stripmap or GB-SAR scene, a raw product or a GB-SAR scan."""
     path = Path(path)
     if not path.exists():
         raise SarcliError(f"{path}: no such file")
     if path.suffix.lower() == ".toml":
-        return from_toml(path)
+        try:
+            doc = tomllib.loads(path.read_text())
+        except tomllib.TOMLDecodeError as e:
+            raise SarcliError(f"{path}: not valid TOML ({e})") from None
+        if "design" in doc or not ("platform" in doc or "rail" in doc):
+            return from_toml(path)
+        return from_stripmap_scene(path) if "platform" in doc else from_gbsar_scene(path)
     from sarcli.io.h5common import attr_str, open_product
 
     with open_product(path) as f:

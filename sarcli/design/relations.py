@@ -51,6 +51,16 @@ def spherical_earth_geometry(height_m: float, look_from_nadir_rad: float,
     return R, math.asin(min(1.0, a * math.sin(look_from_nadir_rad) / earth_radius_m))
 
 
+def look_angle_for_slant_range(height_m: float, slant_range_m: float, earth_radius_m: float = 6371000.0) -> float:
+    """Look angle from nadir (rad) that reaches slant range R: the law of cosines of
+    :func:`spherical_earth_geometry` solved for gamma, cos(gamma) = (a^2 + R^2 - Re^2) / (2 a R)."""
+    a = earth_radius_m + height_m
+    cosg = (a * a + slant_range_m**2 - earth_radius_m**2) / (2 * a * slant_range_m)
+    if not -1.0 <= cosg <= 1.0 or slant_range_m < height_m:
+        raise ValueError(f"no ground point lies at {slant_range_m:.0f} m from a platform {height_m:.0f} m high")
+    return math.acos(cosg)
+
+
 def azimuth_resolution(wavelength_m: float, slant_range_m: float, aperture_m: float,
                        theta_sq_rad: float = math.pi / 2) -> float:
     """delta_az = lam R / (2 L sin(theta_sq)) (seed eq. 15, R_y = lam R0 / (2 L sin(theta))).

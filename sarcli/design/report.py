@@ -36,13 +36,17 @@ def evaluate(p: DesignParams) -> dict[str, Any]:
     notes: list[str] = []
     look = math.radians(p.look_angle_deg)
     if p.platform == "airborne":
-        depression = look if p.look_angle_from == "horizontal" else math.pi / 2 - look
-        slant = p.slant_range_m or rel.flat_earth_slant_range(p.altitude_m, depression)
+        if p.slant_range_m:  # geometry at the given slant range (e.g. a product's range-window centre)
+            slant, depression = p.slant_range_m, math.asin(min(1.0, p.altitude_m / p.slant_range_m))
+        else:
+            depression = look if p.look_angle_from == "horizontal" else math.pi / 2 - look
+            slant = rel.flat_earth_slant_range(p.altitude_m, depression)
         incidence = math.pi / 2 - depression
     else:
         from_nadir = look if p.look_angle_from == "nadir" else math.pi / 2 - look
-        slant_sph, incidence = rel.spherical_earth_geometry(p.altitude_m, from_nadir)
-        slant = p.slant_range_m or slant_sph
+        if p.slant_range_m:
+            from_nadir = rel.look_angle_for_slant_range(p.altitude_m, p.slant_range_m)
+        slant, incidence = rel.spherical_earth_geometry(p.altitude_m, from_nadir)
     swath = p.swath_slant_m
     proc = p.processor
     if swath is None and proc.aod_aperture_m and proc.aod_velocity_mps:
@@ -73,8 +77,10 @@ def evaluate(p: DesignParams) -> dict[str, Any]:
         cons = [
             _constraint("azimuth_sampling", prf > prf_min, prf, prf_min,
                         "PRF > 2v/D" if p.antenna_length_m else "PRF > v / delta_az (processed Doppler bandwidth)"),
-            _constraint("range_unambiguous", prf < prf_max_seed, prf, prf_max_seed, "PRF < c / (2 R_max)",
-                        "" if prf < prf_max_seed else f"{in_flight} pulse(s) in flight at R_max"),
+            _constraint("range_unambiguous", prf < prf_max_seed or p.platform == "spaceborne", prf, prf_max_seed,
+                        "PRF < c / (2 R_max)",
+                        "" if prf < prf_max_seed else f"{in_flight} pulse(s) in flight at R_max"
+                        + (" (spaceborne timing: the echo-window rule decides)" if p.platform == "spaceborne" else "")),
             _constraint("echo_window", ok_win, prf, rel.echo_window_prf_max(swath, p.pulse_length_s),
                         "receive window between transmit events", why),
         ]

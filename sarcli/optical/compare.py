@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from orbit.constants import C_LIGHT
+from sarcli.design.params import doppler_bandwidth
 from sarcli.errors import SarcliError
 from sarcli.focus.quality import point_target_metrics
 from sarcli.io.raw import RawProduct
@@ -90,21 +91,6 @@ def dynamic_range_db(image: np.ndarray, azimuth_time: np.ndarray, slant_range: n
     return 20 * math.log10(a.max() / floor) if floor > 0 else float("inf")
 
 
-def occupied_doppler_bandwidth(echo: np.ndarray, prf_hz: float, energy: float = 0.99) -> float:
-    """Azimuth bandwidth (Hz) holding ``energy`` of the echo's azimuth power spectrum (zero-Doppler data).
-
-    The digital reference processes the band the beam actually illuminated rather than 0.8 PRF: an
-    airborne beam a few metres long spans ~100 Hz of a kHz PRF, and a PRF-wide azimuth filter would
-    make the RD aperture (and its blocks) tens of thousands of lines long for nothing.
-    """
-    spec = np.sum(np.abs(np.fft.fft(echo, axis=0)) ** 2, axis=1)
-    f = np.fft.fftfreq(echo.shape[0], 1.0 / prf_hz)
-    order = np.argsort(np.abs(f))
-    cum = np.cumsum(spec[order]) / np.sum(spec)
-    edge = float(np.abs(f[order][np.searchsorted(cum, energy)]))
-    return min(2.0 * edge, 0.8 * prf_hz)
-
-
 def predictions(raw: RawProduct, settings: OpticalSettings, rows_integrated: int, dnu: float,
                 pixel_delay_s: float) -> dict[str, float]:
     """The finite-aperture predictions listed in the module docstring."""
@@ -154,8 +140,10 @@ def compare(raw: RawProduct, settings: OpticalSettings = OpticalSettings(),
         centre_range_m = brightest_target(raw)["closest_range_m"]
     rows: list[dict[str, Any]] = []
     t0 = time.perf_counter()
+    # the RD processes the band the beam illuminated, not 0.8 PRF (an airborne beam a few metres long
+    # spans ~100 Hz of a kHz PRF; a PRF-wide filter would make the RD aperture tens of thousands of lines)
     slc = focus_rd(raw, GeometricDoppler(v, 0.0, raw.radar.wavelength_m), azimuth_window="rect",
-                   range_window="rect", azimuth_bandwidth_hz=occupied_doppler_bandwidth(raw.echo, raw.radar.prf_hz))
+                   range_window="rect", azimuth_bandwidth_hz=doppler_bandwidth(raw.echo, raw.radar.prf_hz))
     rows.append({"processor": "digital RD", "limitations": [], "remove_bias": False,
                  "seconds": time.perf_counter() - t0,
                  **measure(slc.image, slc.azimuth_time, slc.slant_range, raw, v)})

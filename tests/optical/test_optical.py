@@ -55,12 +55,12 @@ def test_mask_phase_is_pi_b2_y2_over_x(v, prf, f0, R, rows):
 
 
 def test_ideal_optical_equals_digital_rd(raw):
+    from sarcli.design.params import doppler_bandwidth
     from sarcli.focus.doppler_models import GeometricDoppler
     from sarcli.focus.rda import focus_rd
-    from sarcli.optical.compare import occupied_doppler_bandwidth
 
     slc = focus_rd(raw, GeometricDoppler(250.0, 0.0, raw.radar.wavelength_m), azimuth_window="rect",
-                   range_window="rect", azimuth_bandwidth_hz=occupied_doppler_bandwidth(raw.echo, raw.radar.prf_hz))
+                   range_window="rect", azimuth_bandwidth_hz=doppler_bandwidth(raw.echo, raw.radar.prf_hz))
     rd = measure(slc.image, slc.azimuth_time, slc.slant_range, raw, 250.0)
     _, opt = run(raw, "")
     assert abs(opt["range_error_m"]) < 0.5 and abs(opt["azimuth_error_m"]) < 0.05

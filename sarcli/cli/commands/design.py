@@ -11,7 +11,8 @@ from sarcli.errors import SarcliError
 
 
 def design(
-    source: Path = typer.Argument(..., help="Design TOML ([design] table), raw product (.h5) or GB-SAR scan (.h5)."),
+    source: Path = typer.Argument(..., help="Design TOML ([design] table), a stripmap or GB-SAR scene TOML, "
+                                            "a raw product or a GB-SAR scan (.h5)."),
     json_out: bool = typer.Option(False, "--json", help="Print the full report as JSON."),
 ) -> None:
     """Derive resolutions, PRF window, Doppler samples and swath, and check each constraint.
@@ -21,6 +22,8 @@ def design(
       sarcli design samples/aod_ccd_example.toml
 
       sarcli design samples/design_radarsat1.toml --json
+
+      sarcli design samples/gbsar_outdoor.toml
 
       sarcli design raw.h5
 
@@ -60,7 +63,8 @@ def _format(r: dict) -> str:
         lines += [f"  slant range (centre)       {r['slant_range_m']:.1f} m, "
                   f"incidence {r['incidence_angle_deg']:.2f} deg",
                   f"  swath (slant)              {r['swath_slant_m']:.1f} m",
-                  f"  PRF window                 {r['prf_min_hz']:.1f} Hz < PRF < {r['prf_max_hz']:.1f} Hz",
+                  f"  PRF window                 {r['prf_min_hz']:.1f} Hz < PRF < {r['prf_max_hz']:.1f} Hz"
+                  + ("  (upper bound: one pulse in flight)" if r["platform"] == "spaceborne" else ""),
                   "  PRF options:"]
         for o in r["prf_options"]:
             broken = ", ".join(c["name"] for c in o["constraints"] if not c["ok"])
