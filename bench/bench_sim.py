@@ -8,7 +8,9 @@ Timings are best-of-n after a warm-up call (numba compilation or cache load repo
 
 from __future__ import annotations
 
+import re
 import time
+from pathlib import Path
 
 import numpy as np
 from numba import get_num_threads
@@ -18,57 +20,25 @@ from sarcli.sim.kernel import echo_kernel, echo_reference
 from sarcli.sim.scene import parse_scene
 from sarcli.sim.stripmap import _concat, kernel_args, prepare, simulate
 
-BASE = """
-[scene]
-name = "bench"
-seed = 1
-epoch_utc = "2002-06-16T15:41:00Z"
-effects = {effects}
-
-[radar]
-carrier_frequency_hz = 5.3e9
-prf_hz = 1256.9846363282768
-range_sampling_rate_hz = 32317075.0
-chirp_rate_hz_per_s = -0.72135e12
-pulse_length_s = {pulse}
-n_lines = {n_lines}
-n_samples = {n_samples}
-window_start_s = 0.006595629060396091
-
-[antenna]
-length_m = {length}
-height_m = 1.5
-look_angle_deg = 33.5
-
-[platform]
-type = "orbit"
-semi_major_axis_m = 7167100.0
-eccentricity = 0.00115
-inclination_deg = 98.594
-raan_deg = 20.0
-arg_perigee_deg = 90.0
-mean_anomaly_deg = -40.3
-
-[second_channel]
-receiver_offset_m = 5.0
-[noise]
-snr_db = 10.0
-[attitude]
-pitch_deg = 0.02
-
-{targets}
-"""
+SAMPLE = Path(__file__).resolve().parents[1] / "samples" / "rs1_point.toml"
+TABLES = ("[second_channel]\nreceiver_offset_m = 5.0\n[noise]\nsnr_db = 10.0\n[attitude]\npitch_deg = 0.02\n"
+          "[quantization]\nbits = 4\n")
 
 
 def scene(n_targets=8, length=15.0, effects=("range_migration",), n_lines=2048, n_samples=2400,
           pulse=41.74e-6, clutter=""):
+    """The demo scene (samples/rs1_point.toml) with its targets replaced and the given settings."""
+    text = SAMPLE.read_text()
+    text = text[:text.index("[[targets]]")]
+    eff = "[" + ", ".join(f'"{e}"' for e in effects) + "]"
+    for key, value in (("effects", eff), ("pulse_length_s", pulse), ("n_lines", n_lines),
+                       ("n_samples", n_samples), ("length_m", length)):
+        text = re.sub(rf"^{key} = .*$", f"{key} = {value}", text, count=1, flags=re.M)
     rng = np.random.default_rng(0)
     tg = "".join(f"[[targets]]\nslant_range_m = {r:.1f}\nazimuth_time_s = {a:.4f}\n"
                  for r, a in zip(rng.uniform(992500, 996000, n_targets), rng.uniform(-0.15, 0.15, n_targets),
                                  strict=True))
-    eff = "[" + ", ".join(f'"{e}"' for e in effects) + "]"
-    return parse_scene(BASE.format(effects=eff, pulse=pulse, n_lines=n_lines, n_samples=n_samples, length=length,
-                                   targets=tg + clutter), "bench.toml")
+    return parse_scene(text + TABLES + tg + clutter, "bench.toml")
 
 
 def _kernel_inputs(sc):
