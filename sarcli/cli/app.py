@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+import warnings
 
 import typer
 
@@ -49,6 +50,14 @@ def _register_all() -> None:
 _register_all()
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings reach a person as one line, like errors: ``sarcli: warning: ...``."""
+    import sys
+
+    print(f"sarcli: warning: {message}", file=sys.stderr if file is None else file)
+
+
 def main() -> None:
     """Console-script entry point."""
+    warnings.showwarning = _one_line_warning
     app()
