@@ -56,9 +56,9 @@ def kernel_vs_numpy():
     block = max(8, sc.radar.n_lines // (4 * get_num_threads()))
     out = np.zeros(shape, np.complex64)
     t_first = time.perf_counter()
-    echo_kernel(out, *args, block)
+    echo_kernel(out, *args, block, 0, 1 << 62)
     t_first = time.perf_counter() - t_first
-    t_nb = best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block), repeat=3)
+    t_nb = best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block, 0, 1 << 62), repeat=3)
     t_np = best_time(lambda: echo_reference(np.zeros(shape, np.complex64), *args), repeat=1, warmup=0)
     ref = np.zeros(shape, np.complex64)
     echo_reference(ref, *args)
@@ -72,7 +72,7 @@ def kernel_only(sc):
     args, n_ch, work = _kernel_inputs(sc)
     shape = (n_ch, sc.radar.n_lines, sc.radar.n_samples)
     block = max(8, sc.radar.n_lines // (4 * get_num_threads()))
-    return best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block), repeat=3), work
+    return best_time(lambda: echo_kernel(np.zeros(shape, np.complex64), *args, block, 0, 1 << 62), repeat=3), work
 
 
 def main() -> None:

@@ -39,8 +39,10 @@ def chirp_filter(radar, q: int, nfft: int) -> tuple[np.ndarray, int]:
     return scipy.fft.fft(c, nfft) / np.sinc(nu) ** 2, m
 
 
-def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int) -> None:
-    """Add the echoes of the targets in ``args`` (``stripmap.kernel_args`` layout) to ``out`` (n_ch, lines, n)."""
+def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int, tick=None) -> None:
+    """Add the echoes of the targets in ``args`` (``stripmap.kernel_args`` layout) to ``out`` (n_ch, lines, n).
+
+    ``tick(n)`` (optional) is called after each block of n lines."""
     n_ch, n_lines, n_s = out.shape
     fq = q * radar.range_sampling_rate_hz
     m = int(math.floor(0.5 * radar.pulse_length_s * fq))
@@ -56,3 +58,5 @@ def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int) -> 
         splat_kernel(grid, line0, *kargs, block)
         y = scipy.fft.ifft(scipy.fft.fft(grid, nfft, axis=-1) * spec, axis=-1)
         out[:, line0:line0 + nb, :] += y[..., pick]
+        if tick is not None:
+            tick(nb)

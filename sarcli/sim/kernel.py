@@ -114,17 +114,18 @@ def _channel_range(d, rtx, off, ux, k):
 
 @njit(cache=True, parallel=True)
 def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
-                migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
-    """Accumulate every target's echo into out (n_channels, n_lines, n_samples); see the module docstring."""
+                migrate, pattern, laz, lel, block, line0, line1):  # pragma: no cover - compiled
+    """Accumulate every target's echo into lines [line0, line1) of out (n_channels, n_lines, n_samples)."""
     n_ch, n_lines, n_s = out.shape
     n_t = tp.shape[0]
-    n_blocks = (n_lines + block - 1) // block
+    line1 = min(line1, n_lines)
+    n_blocks = (line1 - line0 + block - 1) // block
     dts = 1.0 / fs
     ww_arg = 2.0 * math.pi * kr * dts * dts
     ww = complex(math.cos(ww_arg), math.sin(ww_arg))
     for b in prange(n_blocks):
-        a0 = b * block
-        a1 = min(n_lines, a0 + block)
+        a0 = line0 + b * block
+        a1 = min(line1, a0 + block)
         d = np.empty(3)
         for i in range(n_t):
             for k in range(max(k0[i], a0), min(k1[i], a1)):

@@ -7,6 +7,8 @@ truth; post-processing effects (replica, noise, quantization) in their ORDER.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numba import get_num_threads
 
@@ -71,18 +73,25 @@ def kernel_args(scene: Scene, ctx: SimContext, traj: Trajectory, motion: Motion,
             ctx.range_migration, ctx.antenna_pattern, ant.length_m / lam, ant.height_m / lam)
 
 
-def simulate(scene: Scene, dtype=np.complex64) -> RawProduct:
-    """Simulate the scene's raw echoes (complex64; complex128 for accuracy tests) with its truth."""
+def simulate(scene: Scene, dtype=np.complex64, progress: Callable[[int], None] | None = None) -> RawProduct:
+    """Simulate the scene's raw echoes (complex64; complex128 for accuracy tests) with its truth.
+
+    ``progress(n)`` is called as lines are done (total n_lines, twice that with binned clutter).
+    """
     ctx, traj, motion, axes, rot, points, clutter, patches = prepare(scene)
     rad = scene.radar
     n_ch = len(ctx.receiver_offsets_m)
     out = np.zeros((n_ch, rad.n_lines, rad.n_samples), dtype)
-    block = max(8, rad.n_lines // (4 * get_num_threads()))
+    tick = progress or (lambda n: None)
+    block = max(8, BLOCK_LINES // (4 * get_num_threads()))
     exact = _concat(points, clutter) if scene.clutter_model == "exact" else points
-    echo_kernel(out, *kernel_args(scene, ctx, traj, motion, axes, rot, exact), block)
+    args = kernel_args(scene, ctx, traj, motion, axes, rot, exact)
+    for a in range(0, rad.n_lines, BLOCK_LINES):
+        echo_kernel(out, *args, block, a, a + BLOCK_LINES)
+        tick(min(BLOCK_LINES, rad.n_lines - a))
     if scene.clutter_model == "binned" and len(clutter):
         bargs = kernel_args(scene, ctx, traj, motion, axes, rot, _by_range(clutter, traj, motion))
-        add_binned_echo(out, bargs, rad, scene.clutter_oversampling, max(8, BLOCK_LINES // (4 * get_num_threads())))
+        add_binned_echo(out, bargs, rad, scene.clutter_oversampling, block, tick)
 
     tc = scene.center_time_s
     ux, _, ub, pitch_total = axes

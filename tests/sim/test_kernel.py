@@ -42,7 +42,7 @@ def test_kernel_matches_numpy_reference(orbit_scene, effects):
     n_ch = args[12].size
     a = np.zeros((n_ch, sc.radar.n_lines, sc.radar.n_samples), np.complex128)
     b = np.zeros_like(a)
-    echo_kernel(a, *args, 37)
+    echo_kernel(a, *args, 37, 0, 1 << 62)
     echo_reference(b, *args)
     assert np.abs(b).max() > 0.1
     # one ulp of a 1e6 m range is 1.2e-10 m, i.e. 2.6e-8 rad of carrier phase: the float64 floor
@@ -54,8 +54,8 @@ def test_kernel_complex64_output_close_to_complex128(linear_scene):
     args = _args(sc)
     a = np.zeros((1, sc.radar.n_lines, sc.radar.n_samples), np.complex128)
     b = np.zeros_like(a, dtype=np.complex64)
-    echo_kernel(a, *args, 64)
-    echo_kernel(b, *args, 64)
+    echo_kernel(a, *args, 64, 0, 1 << 62)
+    echo_kernel(b, *args, 64, 0, 1 << 62)
     assert np.max(np.abs(a - b)) < 1e-6
 
 

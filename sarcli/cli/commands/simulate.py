@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info
+from sarcli.cli.common import emit_json, info, progress_bar
 from sarcli.errors import SarcliError
 
 
@@ -46,8 +46,10 @@ def simulate(
     effects = ", ".join(sc.effects) or "none"
     info(f"simulating {sc.name}: {sc.radar.n_lines} x {sc.radar.n_samples} samples, {len(sc.targets)} target(s), "
          f"{len(sc.clutter)} clutter patch(es), effects: {effects}")
+    total = sc.radar.n_lines * (2 if sc.clutter and sc.clutter_model == "binned" else 1)
     t0 = time.perf_counter()
-    raw = run(sc)
+    with progress_bar(total, label="simulating") as bar:
+        raw = run(sc, progress=bar.update)
     elapsed = time.perf_counter() - t0
     if fmt == "ceos":
         from sarcli.io.ceos import write_ceos
