@@ -150,3 +150,12 @@ def test_paper_scenario_compensation(tmp_path, cli):
     assert sorted(p.name for p in figs.iterdir()) == ["mover0_after.png", "mover0_before.png",
                                                       "mover0_conventional.png", "mover0_psf.png"]
     assert abs(m["ati_phase_rad"] - ati_phase(coefficients(Mover(5095.3, 500.0, 10.0, 50.0), P).vm, 2.0, P)) < 0.03
+
+
+def test_bad_knob_is_refused_before_any_work(cli, tmp_path):
+    r = cli("ati", "estimate", str(tmp_path / "missing.h5"), "--route", "magic")
+    assert r.exit_code != 0 and "--route" in r.stderr and "Traceback" not in r.stderr
+    r = cli("ati", "compensate", str(tmp_path / "missing.h5"), "-o", str(tmp_path / "o.h5"), "--method", "foo")
+    assert r.exit_code != 0 and "--method" in r.stderr
+    r = cli("ati", "detect", str(tmp_path / "missing.h5"))
+    assert r.exit_code != 0 and "no such file" in r.stderr

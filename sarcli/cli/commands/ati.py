@@ -87,9 +87,22 @@ def detect_cmd(
         emit_json({"candidates": rows, "summary": summary})
 
 
+def _check(route: str, unwrap: str, bin_mode: str, method: str = "exact") -> None:
+    """Refuse unknown knob values before any heavy work."""
+    from sarcli.ati.estimate import ROUTES
+    from sarcli.ati.pipeline import BIN_MODES, COMPENSATIONS
+    from sarcli.ati.unwrap import METHODS
+
+    for name, v, allowed in (("--route", route, ROUTES), ("--unwrap", unwrap, METHODS), ("--bin", bin_mode, BIN_MODES),
+                             ("--method", method, COMPENSATIONS)):
+        if v not in allowed:
+            raise SarcliError(f"{name} {v!r}: choose one of {', '.join(allowed)}")
+
+
 def _estimate(raw_path: Path, route: str, unwrap: str, bin_mode: str, pfa: float):
     from sarcli.ati.pipeline import process
 
+    _check(route, unwrap, bin_mode)
     raw = _load(raw_path)
     pair, summary, results = process(raw, route, unwrap, bin_mode, _knobs(pfa))
     for f in summary["estimation_failures"]:
@@ -177,6 +190,7 @@ def compensate_cmd(
     """
     from sarcli.ati.pipeline import centroid_row, compensate, peak_position, psf_cut, width_3db
 
+    _check(route, unwrap, bin_mode, method)
     raw, pair, summary, results = _estimate(raw_path, route, unwrap, bin_mode, pfa)
     t = pair.slc0.azimuth_time
     dt = float(t[1] - t[0])
@@ -287,6 +301,7 @@ def montecarlo_cmd(
     from sarcli.ati.montecarlo import parse_snr_range, run
     from sarcli.ati.plots import montecarlo_plot
 
+    _check(route, unwrap, bin_mode)
     snrs = parse_snr_range(snr)
     with progress_bar(runs * len(snrs), label="ati montecarlo") as bar:
         result = run(str(scene), runs, snrs, seed, route, unwrap, bin_mode, on_run=lambda: bar.update(1))
