@@ -244,3 +244,23 @@ def provenance(f: h5py.File) -> dict[str, Any]:
                 pass
         out[k] = v
     return out
+
+
+def write_mapping(parent: h5py.Group, name: str, mapping: dict[str, Any]) -> h5py.Group:
+    """A group holding a free-form mapping: strings as attributes, arrays as datasets, None skipped
+    (used for /truth and similar tables)."""
+    g = group(parent, name)
+    for k in sorted(mapping):
+        v = mapping[k]
+        if isinstance(v, str):
+            g.attrs[k] = v
+        elif v is not None:
+            dataset(g, k, np.asarray(v))
+    return g
+
+
+def read_mapping(g: h5py.Group) -> dict[str, Any]:
+    """Inverse of :func:`write_mapping`."""
+    out: dict[str, Any] = {k: g[k][()] for k in g}
+    out.update({k: attr_str(g, k) for k in g.attrs})
+    return out

@@ -43,7 +43,17 @@ import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import PROVENANCE_ATTRS, atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.h5common import (
+    PROVENANCE_ATTRS,
+    atomic_h5,
+    attr_str,
+    dataset,
+    group,
+    open_product,
+    read_mapping,
+    require,
+    write_mapping,
+)
 
 PRODUCT_TYPE = "raw"
 SCHEMA_VERSION = "1"
@@ -190,12 +200,7 @@ def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = 
                     description="further receive channels", chunks=(1, *chunks), compression=compression)
         dataset(f, "azimuth_time", np.asarray(p.azimuth_time, dtype=np.float64), units="s",
                 description="pulse transmit time after epoch_utc")
-        g = group(f, "radar")
-        for fld in dataclasses.fields(Radar):
-            v = getattr(p.radar, fld.name)
-            if v is None:
-                continue
-            g.attrs[fld.name] = np.asarray(v, dtype=np.float64) if fld.name == "receiver_offsets_m" else v
+        g = write_radar(f, p.radar)
         if p.prf_per_line is not None:
             dataset(g, "prf_per_line", np.asarray(p.prf_per_line, np.float64), units="Hz")
         if p.agc_db is not None:
@@ -203,25 +208,47 @@ def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = 
                     description="receiver attenuation per line; multiply by 10**(agc_db/20) to undo")
         if p.replica is not None:
             dataset(g, "replica", np.asarray(p.replica, np.complex64), units="1")
-        if p.orbit is not None:
-            og = group(f, "orbit")
-            og.attrs["frame"] = p.orbit.frame
-            dataset(og, "time", np.asarray(p.orbit.time, np.float64), units="s")
-            dataset(og, "position", np.asarray(p.orbit.position, np.float64), units="m")
-            dataset(og, "velocity", np.asarray(p.orbit.velocity, np.float64), units="m/s")
-        if p.attitude is not None:
-            ag = group(f, "attitude")
-            dataset(ag, "time", np.asarray(p.attitude.time, np.float64), units="s")
-            for name in ("pitch", "roll", "yaw"):
-                dataset(ag, name, np.asarray(getattr(p.attitude, name), np.float64), units="rad")
+        write_platform(f, p.orbit, p.attitude)
         if p.truth is not None:
-            tg = group(f, "truth")
-            for k in sorted(p.truth):
-                v = p.truth[k]
-                if isinstance(v, str):
-                    tg.attrs[k] = v
-                else:
-                    dataset(tg, k, np.asarray(v))
+            write_mapping(f, "truth", p.truth)
+
+
+def write_radar(f: h5py.Group, radar: Radar) -> h5py.Group:
+    """The /radar group's attributes (shared by the raw and SLC products)."""
+    g = group(f, "radar")
+    for fld in dataclasses.fields(Radar):
+        v = getattr(radar, fld.name)
+        if v is not None:
+            g.attrs[fld.name] = np.asarray(v, dtype=np.float64) if fld.name == "receiver_offsets_m" else v
+    return g
+
+
+def write_platform(f: h5py.Group, orbit: Orbit | None, attitude: Attitude | None) -> None:
+    """/orbit and /attitude groups (shared by the raw and SLC products)."""
+    if orbit is not None:
+        og = group(f, "orbit")
+        og.attrs["frame"] = orbit.frame
+        dataset(og, "time", np.asarray(orbit.time, np.float64), units="s")
+        dataset(og, "position", np.asarray(orbit.position, np.float64), units="m")
+        dataset(og, "velocity", np.asarray(orbit.velocity, np.float64), units="m/s")
+    if attitude is not None:
+        ag = group(f, "attitude")
+        dataset(ag, "time", np.asarray(attitude.time, np.float64), units="s")
+        for name in ("pitch", "roll", "yaw"):
+            dataset(ag, name, np.asarray(getattr(attitude, name), np.float64), units="rad")
+
+
+def read_platform(f: h5py.Group, path: str | os.PathLike) -> tuple[Orbit | None, Attitude | None]:
+    """Inverse of :func:`write_platform` (missing groups -> None)."""
+    orbit = attitude = None
+    if "orbit" in f:
+        og = f["orbit"]
+        orbit = Orbit(require(og, "time", path)[()], require(og, "position", path)[()],
+                      require(og, "velocity", path)[()], attr_str(og, "frame", "ECI"))
+    if "attitude" in f:
+        ag = f["attitude"]
+        attitude = Attitude(*(require(ag, k, path)[()] for k in ("time", "pitch", "roll", "yaw")))
+    return orbit, attitude
 
 
 def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
@@ -255,20 +282,8 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
         radar = Radar(**kw)
         echo = echo_ds[()] if load_echo else np.zeros((echo_ds.shape[0], 0), np.complex64)
         echo_channels = f["echo_channels"][()] if ("echo_channels" in f and load_echo) else None
-        orbit = None
-        if "orbit" in f:
-            og = f["orbit"]
-            orbit = Orbit(require(og, "time", path)[()], require(og, "position", path)[()],
-                          require(og, "velocity", path)[()], attr_str(og, "frame", "ECI"))
-        attitude = None
-        if "attitude" in f:
-            ag = f["attitude"]
-            attitude = Attitude(*(require(ag, k, path)[()] for k in ("time", "pitch", "roll", "yaw")))
-        truth = None
-        if "truth" in f:
-            tg = f["truth"]
-            truth = {k: tg[k][()] for k in tg}
-            truth.update({k: attr_str(tg, k) for k in tg.attrs})
+        orbit, attitude = read_platform(f, path)
+        truth = read_mapping(f["truth"]) if "truth" in f else None
         p = RawProduct(
             echo=echo, azimuth_time=t, epoch_utc=attr_str(f, "epoch_utc") or "", radar=radar,
             look_side=attr_str(f, "look_side", "right"), source=attr_str(f, "source", "unknown"),

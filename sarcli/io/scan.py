@@ -39,7 +39,16 @@ import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.h5common import (
+    atomic_h5,
+    attr_str,
+    dataset,
+    group,
+    open_product,
+    read_mapping,
+    require,
+    write_mapping,
+)
 
 PRODUCT_TYPE = "gbsar_scan"
 SCHEMA_VERSION = "1"
@@ -124,13 +133,7 @@ def _write_static(f: h5py.File, s: Scan) -> None:
     for k, v in sorted(s.instrument.items()):
         g.attrs[k] = v
     if s.truth is not None:
-        tg = group(f, "truth")
-        for k in sorted(s.truth):
-            v = s.truth[k]
-            if isinstance(v, str):
-                tg.attrs[k] = v
-            else:
-                dataset(tg, k, np.asarray(v))
+        write_mapping(f, "truth", s.truth)
 
 
 def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None, inputs: tuple = ()) -> None:
@@ -166,11 +169,7 @@ def read_scan(path: str | os.PathLike) -> Scan:
             return {k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
                     for k, v in f[name].attrs.items()}
 
-        truth = None
-        if "truth" in f:
-            tg = f["truth"]
-            truth = {k: tg[k][()] for k in tg}
-            truth.update({k: attr_str(tg, k) for k in tg.attrs})
+        truth = read_mapping(f["truth"]) if "truth" in f else None
         s = Scan(
             s21=s21,
             frequency=require(f, "frequency", path, shape_rank=1)[()],
