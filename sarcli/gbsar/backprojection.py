@@ -8,7 +8,7 @@ the baseband range profiles P_i of :mod:`sarcli.gbsar.rangecomp` (``P_i(R) = a e
 
 over the stops of the pixel's synthetic aperture (rail within the beam footprint, seed 000 Fig. 2),
 ``w_i`` the azimuth taper over that aperture, so a scatterer focuses to its (pattern-weighted)
-reflectivity with the phase
+reflectivity (times its aperture fraction at the rail ends) with the phase
 ``-4 pi R0/lam`` of seed 000's RD image (eq. 21) at every range: no approximation but the linear
 interpolation of the (oversampled) profile and the centre wavelength in the carrier term, which is
 exact because the profile is referenced to f_c. Flagged stops are left out.
@@ -41,7 +41,10 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, table, out):
 
     Each pixel integrates the stops of its synthetic aperture ``[a, b]`` = rail ``[xs[0], xs[-1]]``
     intersected with the beam footprint ``|x - px| <= half_beam * pr`` (seed 000 eq. 22-40), weighted by
-    the taper ``table`` (sampled on [0, 1]) over [a, b] and normalized by the sum of the weights used.
+    the taper ``table`` (sampled on [0, 1]) over [a, b], normalized by the sum of the weights used and
+    scaled by ``(b - a) / min(X, 2 half_beam R0)``: a pixel whose aperture is cut by a rail end
+    (regions III/IV) is attenuated by its aperture fraction, as in DF and RD, instead of amplifying
+    the leakage of bright targets seen by a few stops at the beam edge.
     """
     n_s, n_r = prof.shape
     for p in prange(px.shape[0]):
@@ -69,7 +72,9 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, table, out):
             v = prof[i, j] * (1.0 - t) + prof[i, j + 1] * t
             acc += w * v * np.exp(1j * kc * r)
             wsum += w
-        out[p] = acc * np.exp(-1j * kc * pr[p]) / wsum if wsum > _W_MIN else 0j
+        nominal = min(xs[n_s - 1] - xs[0], 2.0 * half_beam * pr[p])
+        frac = span / nominal if nominal > 0 else 1.0
+        out[p] = acc * np.exp(-1j * kc * pr[p]) * frac / wsum if wsum > _W_MIN else 0j
 
 
 def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, wcode: int) -> np.ndarray:
@@ -88,8 +93,10 @@ def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_be
         v = np.interp(r, rgrid, prof[i].real) + 1j * np.interp(r, rgrid, prof[i].imag)
         acc += np.where(use, w * v * np.exp(1j * kc * r), 0)
         wsum += np.where(use, w, 0)
+    nominal = np.minimum(xs[-1] - xs[0], 2.0 * half_beam * pr)
+    frac = np.where(nominal > 0, span / np.where(nominal > 0, nominal, 1.0), 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(wsum > _W_MIN, acc * np.exp(-1j * kc * pr) / wsum, 0)
+        return np.where(wsum > _W_MIN, acc * np.exp(-1j * kc * pr) * frac / wsum, 0)
 
 
 def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_length_m: float | None,

@@ -52,6 +52,7 @@ class FocusOptions:
     rd_oversample: int = 2
     df_oversample: int = 2
     beam_limited: bool = True
+    rd_reference: str = "sinc"
 
 
 @dataclass
@@ -111,7 +112,7 @@ def _rd(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions, 
     prof = range_compress(scan, pol, opts.range_window, opts.rd_oversample,
                           max_range_m=float(grid.ranges[rows][-1]) * 1.05 + 1.0)
     img = focus_rd(prof, antenna_length_m, n_xfft, opts.azimuth_window,
-                   max_range_m=float(grid.ranges[rows][-1]) + 1e-9)
+                   max_range_m=float(grid.ranges[rows][-1]) + 1e-9, reference=opts.rd_reference)
     ri = np.rint(grid.ranges[rows] / img.ranges_m[1]).astype(np.int64) if img.ranges_m.size > 1 else \
         np.zeros(rows.size, np.int64)
     ci = np.rint((grid.azimuths - img.azimuth_first_m) / img.dx_m).astype(np.int64)

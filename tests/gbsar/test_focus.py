@@ -51,7 +51,7 @@ def test_range_compression_peak_phase_and_sidelobes():
 
 def _indoor_scan():
     """Seed 000's indoor geometry: point targets at 5 m across the beam, a wall at 6 m, sinc beam."""
-    pts = [(x, 5.0) for x in (-1.6, -0.8, 0.0, 0.8, 1.6)]
+    pts = [(x, 5.0) for x in (-1.4, -0.7, 0.0, 0.7, 1.4)]  # whole footprints on the 4 m rail
     wall = [{"start_m": [-3.0, 6.0, 0.0], "end_m": [3.0, 6.0, 0.0], "spacing_m": 0.01, "scattering": 0.05}]
     return scan_of(pts, walls=wall, effects={"antenna_pattern": {}})
 
@@ -71,7 +71,7 @@ def test_indoor_rd_and_bp_focus_target_and_wall(indoor_images):
     for alg in ("bp", "rd"):
         img = indoor_images[alg]
         amps = []
-        for x in (-1.6, -0.8, 0.0, 0.8, 1.6):
+        for x in (-1.4, -0.7, 0.0, 0.7, 1.4):
             i, j, a = peak_near(img, g.ranges, g.azimuths, 5.0, x)
             assert abs(g.azimuths[j] - x) <= dx + 1e-9 and abs(g.ranges[i] - 5.0) <= dr, (alg, x)
             amps.append(a)
@@ -87,12 +87,12 @@ def test_indoor_df_fails_near_range(indoor_images):
     assert df_min_range(LAM, 4.0, 0.25) > 5.0
     img = indoor_images["df"]
     _, _, centre = peak_near(img, g.ranges, g.azimuths, 5.0, 0.0)
-    _, j, edge = peak_near(img, g.ranges, g.azimuths, 5.0, 1.6)
+    _, j, edge = peak_near(img, g.ranges, g.azimuths, 5.0, 1.4)
     loss_db = 20 * np.log10(edge / centre)
-    shift = abs(g.azimuths[j] - 1.6)
+    shift = abs(g.azimuths[j] - 1.4)
     assert loss_db < -6.0 or shift > 0.05
     bp = indoor_images["bp"]
-    assert 20 * np.log10(peak_near(bp, g.ranges, g.azimuths, 5.0, 1.6)[2] /
+    assert 20 * np.log10(peak_near(bp, g.ranges, g.azimuths, 5.0, 1.4)[2] /
                          peak_near(bp, g.ranges, g.azimuths, 5.0, 0.0)[2]) > -1.0
 
 
@@ -107,7 +107,7 @@ def test_pslr_near_theory():
     s = scan_of([(0.0, 5.0)], effects={"antenna_pattern": {}}, antenna={"pattern": "rect"})
     grid = Grid(ranges=np.arange(3.5, 6.5, 0.01), azimuths=np.arange(-30, 31) * 0.05)
     for alg in ("bp", "rd"):
-        img = focus_scan(s, FocusOptions(algorithm=alg), grid=grid).image[0]
+        img = focus_scan(s, FocusOptions(algorithm=alg, rd_reference="rect"), grid=grid).image[0]
         i, j = np.unravel_index(int(np.argmax(np.abs(img))), img.shape)
         assert pslr_db(img[:, j], 60) == pytest.approx(HAMMING_PSLR_DB, abs=2.5), alg
         if alg == "rd":
@@ -180,7 +180,7 @@ def test_rd_resolution_by_region(r0, xc):
     r0 = float(np.round(r0 / dr) * dr)
     s = scan_of([(xc, r0)], bw=200e6, n=201, effects={"antenna_pattern": {}}, antenna={"pattern": "rect"})
     _, res = azimuth_resolution(r0, xc, 4.0, LAM, 0.25)
-    opts = FocusOptions(algorithm="rd", azimuth_window="none", range_window="none")
+    opts = FocusOptions(algorithm="rd", azimuth_window="none", range_window="none", rd_reference="rect")
     grid = Grid(ranges=np.array([r0]), azimuths=np.arange(-200, 201) * 0.05)
     row = fft_upsample(focus_scan(s, opts, grid=grid).image[0, 0], 16)
     ax = grid.azimuths[0] + np.arange(row.size) * 0.05 / 16
