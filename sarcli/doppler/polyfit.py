@@ -42,20 +42,6 @@ class Poly2D:
                 out = out + self.coef[i, j] * u**i * v**j
         return out
 
-    def derivative_y(self, x, y) -> np.ndarray:
-        """dz/dy (physical units of y)."""
-        u = (np.asarray(x, float) - self.x0) / self.xs
-        v = (np.asarray(y, float) - self.y0) / self.ys
-        u, v = np.broadcast_arrays(u, v)
-        out = np.zeros(u.shape)
-        for i in range(self.coef.shape[0]):
-            for j in range(1, self.coef.shape[1]):
-                out = out + self.coef[i, j] * j * u**i * v ** (j - 1)
-        return out / self.ys
-
-    def to_dict(self) -> dict:
-        return {"coef": self.coef, "x0": self.x0, "xs": self.xs, "y0": self.y0, "ys": self.ys}
-
 
 def _norm(a: np.ndarray) -> tuple[float, float]:
     lo, hi = float(np.min(a)), float(np.max(a))
