@@ -37,5 +37,43 @@ bench: $(STAMP)
 lint: $(STAMP)
 	$(BIN)/ruff check sarcli orbit tests bench
 
+## batch: reprocess a folder, raw -> doppler -> slc -> GeoTIFF + quicklook (focus, issue 5):
+##   make batch IN=dir OUT=dir [-j N]. IN holds raw products (NAME.h5) and CEOS scene folders
+##   (NAME/ with DAT_01.001, ingested first). Only what is missing or older than its inputs is rebuilt;
+##   the first bad input stops make with the file's name (sarcli: error: ...).
+BATCH_H5    := $(if $(IN),$(wildcard $(IN)/*.h5))
+BATCH_CEOS  := $(if $(IN),$(patsubst %/DAT_01.001,%,$(wildcard $(IN)/*/DAT_01.001)))
+BATCH_NAMES := $(notdir $(basename $(BATCH_H5))) $(notdir $(BATCH_CEOS))
+FOCUS_FLAGS ?=
+
+.PHONY: batch
+batch: $(STAMP)
+	@test -n "$(IN)" -a -n "$(OUT)" || { echo "usage: make batch IN=dir OUT=dir [-j N]" >&2; exit 2; }
+	@test -d "$(IN)" || { echo "make batch: input folder $(IN) does not exist" >&2; exit 2; }
+	@test -n "$(strip $(BATCH_NAMES))" || { echo "make batch: no raw products or CEOS folders in $(IN)" >&2; exit 2; }
+	@$(MAKE) --no-print-directory $(foreach n,$(BATCH_NAMES),$(OUT)/$(n).tif $(OUT)/$(n).png)
+
+$(OUT):
+	@mkdir -p $@
+
+$(OUT)/%.raw.h5: $(IN)/%/DAT_01.001 | $(OUT)
+	$(BIN)/sarcli ingest $(IN)/$* -o $@
+
+$(OUT)/%.doppler.h5: $(IN)/%.h5 | $(OUT)
+	$(BIN)/sarcli doppler $< -o $@
+
+$(OUT)/%.doppler.h5: $(OUT)/%.raw.h5 | $(OUT)
+	$(BIN)/sarcli doppler $< -o $@
+
+$(OUT)/%.slc.h5 $(OUT)/%.tif $(OUT)/%.png: $(IN)/%.h5 $(OUT)/%.doppler.h5
+	$(BIN)/sarcli focus $< --doppler $(word 2,$^) -o $(OUT)/$*.slc.h5 --geotiff $(OUT)/$*.tif \
+	  --quicklook $(OUT)/$*.png $(FOCUS_FLAGS)
+
+$(OUT)/%.slc.h5 $(OUT)/%.tif $(OUT)/%.png: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5
+	$(BIN)/sarcli focus $< --doppler $(word 2,$^) -o $(OUT)/$*.slc.h5 --geotiff $(OUT)/$*.tif \
+	  --quicklook $(OUT)/$*.png $(FOCUS_FLAGS)
+
+.PRECIOUS: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5 $(OUT)/%.slc.h5
+
 clean:
 	rm -rf $(DEMO) .pytest_cache .hypothesis .numba_cache

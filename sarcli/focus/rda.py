@@ -49,6 +49,7 @@ from sarcli.io.raw import RawProduct
 from sarcli.io.slc import SLC, DopplerUsed
 
 SRC_GUARD = 64
+CHUNK = 256  # rows per chunk of the row-wise steps (range compression, SRC + RCMC)
 
 
 @dataclass(frozen=True)
@@ -235,26 +236,51 @@ def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan
     return _Plan(prf, ranges, lam, ba, shift, pad, n_fft_az, n_valid, n_fft_r, aperture)
 
 
-def _rcmc_upsampled(zz, out, factor, f_bin, p, dr, v, fdc, dt, ph0, wtab, kind, table, workers, rows=256):
-    """RCMC + azimuth filter from range spectra ``zz`` (n_az, n2), upsampled ``factor`` x in range.
+def _fft_columns(y: np.ndarray, inverse: bool, workers: int, cols: int = 256) -> None:
+    """In place azimuth (axis 0) FFT in column chunks (scipy copies a whole array for axis 0)."""
+    f = sfft.ifft if inverse else sfft.fft
+    for c in range(0, y.shape[1], cols):
+        y[:, c:c + cols] = f(y[:, c:c + cols], axis=0, workers=workers)
 
-    Rows are processed in chunks: zero-pad each spectrum in its middle (Fourier interpolation), IFFT,
-    and let the kernel interpolate on the ``factor`` x finer grid into ``out`` (n_az, n_range). With
-    factor 2 the data sit below a quarter of the sampling rate, where the windowed sinc is flat
-    (bench: range IRW and sidelobes of a 1.07x oversampled Radarsat-1 chirp). ``factor`` is folded into
-    the window table (the IFFT of the longer spectrum divides by factor x n2).
+
+def _src_rcmc_rows(y, factor, inv_k, f_bin, p, fs, v, fdc, dt, ph0, wtab, kind, table, workers, timings,
+                   rows=CHUNK):
+    """SRC, range upsampling and RCMC + azimuth filter of the range-Doppler block ``y``, in place.
+
+    Every azimuth-frequency row is independent, so rows are processed in chunks: range FFT (64-sample
+    guard against wrap-around), the SRC phase ``exp(-j pi f_tau^2 inv_k[row])`` (zero: none), zero
+    padding in the middle of the spectrum to ``factor`` x the length (Fourier interpolation), IFFT, and
+    the kernel interpolates on the ``factor`` x finer grid back into ``y``. With factor 2 the data sit
+    below a quarter of the sampling rate, where the windowed sinc is flat (a Radarsat-1 chirp is sampled
+    at only 1.07 x its band: bench). ``factor`` is folded into the window table (the IFFT of the longer
+    spectrum divides by factor x n2).
     """
-    na, n2 = zz.shape
+    na, nr = y.shape
+    n2 = sfft.next_fast_len(nr + SRC_GUARD)
     h = (n2 + 1) // 2
+    ones = np.ones(n2, y.dtype)
+    f_tau = sfft.fftfreq(n2, 1.0 / fs)
     w = wtab * factor
+    dr = C / (2.0 * fs)
     for c in range(0, na, rows):
         d = min(na, c + rows)
-        up = np.zeros((d - c, factor * n2), zz.dtype)
-        up[:, :h] = zz[c:d, :h]
-        up[:, factor * n2 - (n2 - h):] = zz[c:d, h:]
-        up = sfft.ifft(up, axis=1, overwrite_x=True, workers=workers)
-        rcmc_azimuth(up, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
-                     p.prf, p.ba, w, kind, table, p.shift, out[c:d])
+        t0 = time.perf_counter()
+        zz = np.zeros((d - c, n2), y.dtype)
+        zz[:, :nr] = y[c:d]
+        zz = sfft.fft(zz, axis=1, overwrite_x=True, workers=workers)
+        if np.any(inv_k[c:d]):
+            apply_range_filter_2d(zz, ones, f_tau, inv_k[c:d])
+        if factor > 1:
+            up = np.zeros((d - c, factor * n2), y.dtype)
+            up[:, :h] = zz[:, :h]
+            up[:, factor * n2 - (n2 - h):] = zz[:, h:]
+            zz = up
+        zz = sfft.ifft(zz, axis=1, overwrite_x=True, workers=workers)
+        t1 = time.perf_counter()
+        rcmc_azimuth(zz, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
+                     p.prf, p.ba, w, kind, table, p.shift, y[c:d])
+        timings["src_s"] += t1 - t0
+        timings["rcmc_azimuth_s"] += time.perf_counter() - t1
 
 
 def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
@@ -281,6 +307,7 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
     h = h.astype(cdt)
     wtab = window_table(k.azimuth_window)
     kind, table = table_for(k.rcmc)
+    table = table.astype(np.float32 if k.precision == "single" else np.float64)  # single: complex64 taps
     f_bin = sfft.fftfreq(p.n_fft_az, 1.0 / p.prf)
     dr = C / (2.0 * radar.range_sampling_rate_hz)
     gain = None if raw.agc_db is None else (10.0 ** (np.asarray(raw.agc_db, np.float64) / 20.0)).astype(np.float32)
@@ -307,14 +334,16 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
         if data.shape != (z - a, nr):
             raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
         t0 = time.perf_counter()
-        x = compress_lines(data if gain is None else data * gain[a:z, None], h, nr, k.workers)
         y = np.zeros((p.n_fft_az, nr), cdt)
         off = a - (s - p.pad)
-        y[off:off + (z - a)] = x
-        del x, data
+        for c in range(0, z - a, CHUNK):  # in row chunks: no second block-sized buffer
+            d = min(z - a, c + CHUNK)
+            y[off + c:off + d] = compress_lines(data[c:d] if gain is None else data[c:d] * gain[a + c:a + d, None],
+                                                h, nr, k.workers)
+        del data
         timings["range_compression_s"] += time.perf_counter() - t0
         t0 = time.perf_counter()
-        y = sfft.fft(y, axis=0, overwrite_x=True, workers=k.workers)
+        _fft_columns(y, inverse=False, workers=k.workers)
         timings["azimuth_fft_s"] += time.perf_counter() - t0
         tb = float(t_raw[0] + 0.5 * (s + e - 1) * dt)
         fdc, fr, v, sq = doppler_on_grid(doppler, p.ranges, tb, p.wavelength)
@@ -327,26 +356,19 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
         dts.append(dt_orbit)
         t0 = time.perf_counter()
         if k.src or k.rcmc_oversample > 1:
-            # range spectrum of the range-Doppler data (64-sample guard against wrap-around)
-            n2 = sfft.next_fast_len(nr + SRC_GUARD)
-            zz = sfft.fft(y, n=n2, axis=1, workers=k.workers)
+            inv_k = np.zeros(p.n_fft_az)
             if k.src:
                 off_f = f_bin - fdc[nr // 2]
                 f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
                 inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
-                apply_range_filter_2d(zz, np.ones(n2, cdt), sfft.fftfreq(n2, 1.0 / radar.range_sampling_rate_hz),
-                                      inv_k)
-            timings["src_s"] += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            _rcmc_upsampled(zz, y, k.rcmc_oversample, f_bin, p, dr, v, fdc, dt_orbit, ph_orbit, wtab, kind, table,
-                            k.workers)
-            del zz
+            _src_rcmc_rows(y, k.rcmc_oversample, inv_k, f_bin, p, radar.range_sampling_rate_hz, v, fdc, dt_orbit,
+                           ph_orbit, wtab, kind, table, k.workers, timings)
         else:
             rcmc_azimuth(y, f_bin, float(p.ranges[0]), dr, p.ranges, v, fdc, dt_orbit, ph_orbit, p.wavelength,
                          p.prf, p.ba, wtab, kind, table, p.shift, y)
-        timings["rcmc_azimuth_s"] += time.perf_counter() - t0
+            timings["rcmc_azimuth_s"] += time.perf_counter() - t0
         t0 = time.perf_counter()
-        y = sfft.ifft(y, axis=0, overwrite_x=True, workers=k.workers)
+        _fft_columns(y, inverse=True, workers=k.workers)
         timings["azimuth_ifft_s"] += time.perf_counter() - t0
         t0 = time.perf_counter()
         sink(s, y[p.pad:p.pad + (e - s)].astype(np.complex64, copy=False))

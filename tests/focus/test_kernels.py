@@ -25,10 +25,12 @@ def test_rcmc_azimuth_kernel_matches_numpy(interp):
     f_bin = np.fft.fftfreq(na, 1 / prf)
     dr = 6.0
     r0 = 850e3 + np.arange(nr) * dr
-    v = np.linspace(7000, 7010, nr)
-    fdc = np.linspace(-5100, -5050, nr)
-    dt = np.linspace(-1e-4, 1e-4, nr)
-    ph0 = np.linspace(0, 1, nr)
+    # range variation of a Radarsat-1 swath scaled to 96 bins (the kernel interpolates position and
+    # phase linearly over 32 bins): centroid 130 Hz, velocity 20 m/s, orbit timing 0.1 ms per 2400 bins
+    v = np.linspace(7000, 7000.8, nr)
+    fdc = np.linspace(-5100, -5095, nr)
+    dt = np.linspace(-2e-6, 2e-6, nr)
+    ph0 = np.linspace(0, 0.05, nr)
     kind, table = table_for(interp)
     out = np.zeros_like(s)
     rcmc_azimuth(s, f_bin, r0[0], dr, r0, v, fdc, dt, ph0, 0.0566, prf, 1200.0, window_table("hamming"), kind,
