@@ -136,16 +136,17 @@ def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, en
         ci = np.zeros(nrb)
         en = np.zeros(nrb)
         for m in range(m0, m1):
-            a = x[m + 1]
-            b = x[m]
             for jb in range(nrb):
-                k0 = samp0[jb]
-                k1 = k0 + nsamp[jb]
+                # slices start at 0, so numba can drop the negative-index wraparound test and the
+                # loops vectorize (2.6x faster than indexing the whole line from k0)
+                n = nsamp[jb]
+                a = x[m + 1, 2 * samp0[jb]:2 * (samp0[jb] + n)]
+                b = x[m, 2 * samp0[jb]:2 * (samp0[jb] + n)]
                 sr = np.float32(0.0)
                 si = np.float32(0.0)
                 se = np.float32(0.0)
                 if sign_mode:
-                    for k in range(k0, k1):
+                    for k in range(n):
                         ar = _sgn(a[2 * k])
                         ai = _sgn(a[2 * k + 1])
                         br = _sgn(b[2 * k])
@@ -154,7 +155,7 @@ def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, en
                         si += ai * br - ar * bi
                         se += ar * ar + ai * ai + br * br + bi * bi
                 else:
-                    for k in range(k0, k1):
+                    for k in range(n):
                         ar = a[2 * k]
                         ai = a[2 * k + 1]
                         br = b[2 * k]
