@@ -151,6 +151,8 @@ def focus_cmd(
     criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg) for auto."),
     near: str = typer.Option("bp", "--near", help="auto's near-range algorithm: bp | rd."),
     n_xfft: int = typer.Option(None, "--n-xfft", help="Azimuth FFT size for DF/RD [default: the paper's rule]."),
+    rd_reference: str = typer.Option("sinc", "--rd-reference", help="RD reference weighting: sinc (real "
+                                     "antenna) | rect (the paper's ideal beam)."),
     range_window: str = typer.Option("hamming", "--range-window", help="hamming | hann | none."),
     azimuth_window: str = typer.Option("hamming", "--azimuth-window", help="hamming | hann | none."),
     geotiff: Path = typer.Option(None, "--geotiff", help="Amplitude (dB) GeoTIFF in UTM of the first polarization."),
@@ -180,7 +182,8 @@ def focus_cmd(
     s = read_scan(scan)
     opts = FocusOptions(algorithm=algorithm, range_window=range_window, azimuth_window=azimuth_window,
                         max_range_m=max_range, min_range_m=min_range, pixel_x_m=pixel_x, width_m=width,
-                        criterion_rad=math.radians(criterion_deg), near=near, n_xfft=n_xfft)
+                        criterion_rad=math.radians(criterion_deg), near=near, n_xfft=n_xfft,
+                        rd_reference=rd_reference)
     pols = tuple(p.upper() for p in pol) if pol else None
     for p in pols or ():
         s.pol(p)
