@@ -118,3 +118,15 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_len
     bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
               half, taper_table(WINDOW_CODE[azimuth_window]), out)
     return out.reshape(shape)
+
+
+def backproject_polar(prof: RangeProfiles, rc: np.ndarray, sines: np.ndarray, antenna_length_m: float | None,
+                      azimuth_window: str = "hamming") -> np.ndarray:
+    """BP on a polar grid about the rail centre (DF's native grid): rows ``rc`` (distance from the rail
+    centre, m), columns ``sines`` (sin of the angle from boresight) -> (n_rc, n_s) complex64.
+
+    The phase convention stays ``-4 pi R0/lam`` (R0 = rc cos(theta)); multiply by
+    ``exp(-j 4 pi (rc - R0)/lam)`` for DF's ``-4 pi Rc/lam``."""
+    centre = 0.5 * (prof.positions_m[0] + prof.positions_m[-1])
+    rc2, s2 = np.meshgrid(np.asarray(rc, np.float64), np.asarray(sines, np.float64), indexing="ij")
+    return backproject(prof, centre + rc2 * s2, rc2 * np.sqrt(1.0 - s2 ** 2), antenna_length_m, azimuth_window)

@@ -291,3 +291,30 @@ def test_df_below_its_limit_is_reported():
     b = f.report["df_below_limit"]
     assert b["limit_m"] == pytest.approx(df_min_range(LAM, 4.0, 0.25)) and b["eq11_phase_error_rad"] > np.pi / 4
     assert "df_below_limit" not in focus_scan(s, FocusOptions(algorithm="auto", max_range_m=15.0)).report
+
+
+def test_bp_polar_grid_matches_df_native_grid_far_away():
+    """On DF's own polar grid (no geometric correction) DF and the exact BP agree beyond the DF limit."""
+    from sarcli.gbsar.backprojection import backproject_polar
+    from sarcli.gbsar.deramp import focus_df
+
+    pts = [(2.0, 60.0), (-6.0, 110.0)]
+    s = scan_of(pts, bw=200e6, n=401, rail=5.0)
+    df = focus_df(range_compress(s, "VV", oversample=2), n_xfft=256)
+    keep = (df.ranges_m > 50) & (df.ranges_m < 120)
+    rc = df.ranges_m[keep]
+    bp = backproject_polar(range_compress(s, "VV", oversample=4), rc, df.sines, None)
+    dfi = df.data[keep]
+    r0 = rc[:, None] * np.sqrt(1 - df.sines[None, :] ** 2)
+    dfi_r0 = dfi * np.exp(-4j * np.pi * (r0 - rc[:, None]) / LAM)  # DF's -4 pi Rc/lam -> -4 pi R0/lam
+    for x, r in pts:
+        rct = np.hypot(x, r)
+        i = int(np.argmin(abs(rc - rct)))
+        j = int(np.argmin(abs(df.sines - x / rct)))
+        sub_b = np.abs(bp[i - 2:i + 3, j - 2:j + 3])
+        sub_d = np.abs(dfi[i - 2:i + 3, j - 2:j + 3])
+        assert np.unravel_index(np.argmax(sub_b), sub_b.shape) == np.unravel_index(np.argmax(sub_d), sub_d.shape)
+        ib, jb = np.unravel_index(np.argmax(sub_b), sub_b.shape)
+        assert abs(20 * np.log10(sub_d[ib, jb] / sub_b[ib, jb])) < 0.5
+        dphi = np.angle(dfi_r0[i - 2 + ib, j - 2 + jb] * np.conj(bp[i - 2 + ib, j - 2 + jb]))
+        assert abs(dphi) < 0.2
