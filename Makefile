@@ -25,6 +25,10 @@ demo: $(STAMP)
 	$(BIN)/sarcli simulate samples/rs1_point.toml --format ceos -o $(DEMO)/ceos
 	$(BIN)/sarcli ingest $(DEMO)/ceos -o $(DEMO)/ingested.h5
 	$(BIN)/sarcli info $(DEMO)/ingested.h5
+	$(BIN)/sarcli doppler $(DEMO)/raw.h5 -o $(DEMO)/doppler.h5
+	$(BIN)/sarcli focus $(DEMO)/raw.h5 --doppler $(DEMO)/doppler.h5 -o $(DEMO)/slc.h5 --geotiff $(DEMO)/amplitude.tif \
+	  --geotiff-slant $(DEMO)/amplitude_slant.tif --quicklook $(DEMO)/quicklook.png
+	$(BIN)/sarcli quality $(DEMO)/slc.h5
 
 ## test: the whole suite (what CI runs)
 test: $(STAMP)

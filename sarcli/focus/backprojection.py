@@ -19,14 +19,13 @@ import numpy as np
 import scipy.fft as sfft
 from numba import njit, prange
 
-from sarcli.focus.windows import window, window_table
+from sarcli.focus.windows import table_lookup, window, window_table
 
 
 @njit(parallel=True, cache=True)
 def backproject(rc, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba, wtab, out):
     """BP kernel: ``rc`` (n_lines, n_range) on ranges r_first + i dr; pix (M, 3); writes out (M,)."""
     na, nr = rc.shape
-    ntab = wtab.shape[0]
     k4 = 4.0 * np.pi / wavelength
     for m in prange(pix.shape[0]):
         acc = 0.0j
@@ -39,12 +38,7 @@ def backproject(rc, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba, wtab
             u = (f - fdc[m]) / ba
             if u < -0.5 or u > 0.5:
                 continue
-            t = (u + 0.5) * (ntab - 1)
-            j = int(t)
-            if j > ntab - 2:
-                j = ntab - 2
-            a = t - j
-            w = wtab[j] * (1.0 - a) + wtab[j + 1] * a
+            w = table_lookup(wtab, u)
             p = (r - r_first) / dr
             i = int(np.floor(p))
             if i < 0 or i + 1 >= nr:

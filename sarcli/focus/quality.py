@@ -225,16 +225,26 @@ def measure_targets(slc, positions: list[tuple[float, float]], truth_known: bool
     return out
 
 
-def image_statistics(image: np.ndarray) -> dict:
-    """Focus-quality statistics of an image region (no targets needed), computed on intensity I = |z|^2.
+def image_statistics(blocks) -> dict:
+    """Focus-quality statistics of an image (no targets needed), on intensity I = |z|^2.
 
+    ``blocks``: the image, or an iterable of row blocks (bounded memory for full scenes).
     contrast = std(I) / mean(I) (higher = sharper; 1 for fully developed speckle);
-    entropy = -sum(p ln p), p = I / sum(I) (lower = sharper; the autofocus criterion).
+    entropy = -sum(p ln p), p = I / S, S = sum(I) (lower = sharper; the autofocus criterion),
+    accumulated as ln S - sum(I ln I) / S in float64.
     """
-    inten = np.abs(np.asarray(image, np.complex128)) ** 2
-    total = inten.sum()
-    if not total > 0:
+    if isinstance(blocks, np.ndarray):
+        blocks = [blocks]
+    n, s1, s2, sl = 0, 0.0, 0.0, 0.0
+    for b in blocks:
+        inten = (np.abs(np.asarray(b)) ** 2).astype(np.float64).ravel()
+        n += inten.size
+        s1 += inten.sum()
+        s2 += np.dot(inten, inten)
+        pos = inten[inten > 0]
+        sl += float(np.dot(pos, np.log(pos)))
+    if not s1 > 0:
         raise SarcliError("image has no signal: statistics undefined")
-    p = inten[inten > 0] / total
-    return {"contrast": float(inten.std() / inten.mean()), "entropy": float(-np.sum(p * np.log(p))),
-            "n_pixels": int(inten.size)}
+    mean = s1 / n
+    return {"contrast": float(np.sqrt(max(s2 / n - mean * mean, 0.0)) / mean),
+            "entropy": float(np.log(s1) - sl / s1), "n_pixels": int(n)}

@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit, prange
 
 from sarcli.focus.interp import interpolate_numpy
-from sarcli.focus.windows import window
+from sarcli.focus.windows import table_lookup, window
 
 SPAN = 32
 
@@ -90,7 +90,6 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
     """
     na = s.shape[0]
     nout = r0.shape[0]
-    ntab = wtab.shape[0]
     nph = table.shape[0] - 1
     taps = table.shape[1]
     k0 = taps // 2 - 1
@@ -122,13 +121,7 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
                 if u < -0.5 or u > 0.5:
                     out[k, i] = 0.0
                     continue
-                t = (u + 0.5) * (ntab - 1)
-                j = int(t)
-                if j > ntab - 2:
-                    j = ntab - 2
-                a = t - j
-                w = wtab[j] * (1.0 - a) + wtab[j + 1] * a
-                out[k, i] = _sample(row, p, kind, table, nph, taps, k0) * w * ph_c
+                out[k, i] = _sample(row, p, kind, table, nph, taps, k0) * table_lookup(wtab, u) * ph_c
             i0 = stop
 
 

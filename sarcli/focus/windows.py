@@ -13,6 +13,7 @@ sinc(B x): IRW = 0.886/B, PSLR = -13.26 dB.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from sarcli.errors import SarcliError
 
@@ -58,3 +59,15 @@ def window(spec: str | tuple[str, float], u: np.ndarray) -> np.ndarray:
 def window_table(spec: str | tuple[str, float], n: int = 4097) -> np.ndarray:
     """The window tabulated at ``n`` points over u in [-1/2, 1/2] (for numba kernels: linear lookup)."""
     return window(spec, np.linspace(-0.5, 0.5, n))
+
+
+@njit(inline="always", cache=True)
+def table_lookup(wtab, u):
+    """Linear interpolation of a :func:`window_table` at u in [-1/2, 1/2] (numba kernels)."""
+    n = wtab.shape[0]
+    t = (u + 0.5) * (n - 1)
+    j = int(t)
+    if j > n - 2:
+        j = n - 2
+    a = t - j
+    return wtab[j] * (1.0 - a) + wtab[j + 1] * a

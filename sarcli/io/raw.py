@@ -223,6 +223,24 @@ def write_radar(f: h5py.Group, radar: Radar) -> h5py.Group:
     return g
 
 
+def read_radar(g: h5py.Group, path: str | os.PathLike) -> Radar:
+    """Inverse of :func:`write_radar`; a missing required attribute is refused in one line."""
+    kw: dict[str, Any] = {}
+    for fld in dataclasses.fields(Radar):
+        if fld.name in g.attrs:
+            v = g.attrs[fld.name]
+            if fld.name == "receiver_offsets_m":
+                v = tuple(float(x) for x in np.atleast_1d(v))
+            elif fld.name == "quantization_bits":
+                v = int(v)
+            else:
+                v = float(v)
+            kw[fld.name] = v
+        elif fld.default is dataclasses.MISSING:
+            raise ProductError(f"{path}: malformed product, radar attribute '{fld.name}' missing")
+    return Radar(**kw)
+
+
 def write_platform(f: h5py.Group, orbit: Orbit | None, attitude: Attitude | None) -> None:
     """/orbit and /attitude groups (shared by the raw and SLC products)."""
     if orbit is not None:
@@ -266,20 +284,7 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
         if "radar" not in f:
             raise ProductError(f"{path}: malformed product, missing 'radar'")
         g = f["radar"]
-        kw: dict[str, Any] = {}
-        for fld in dataclasses.fields(Radar):
-            if fld.name in g.attrs:
-                v = g.attrs[fld.name]
-                if fld.name == "receiver_offsets_m":
-                    v = tuple(float(x) for x in np.atleast_1d(v))
-                elif fld.name == "quantization_bits":
-                    v = int(v)
-                else:
-                    v = float(v)
-                kw[fld.name] = v
-            elif fld.default is dataclasses.MISSING:
-                raise ProductError(f"{path}: malformed product, radar attribute '{fld.name}' missing")
-        radar = Radar(**kw)
+        radar = read_radar(g, path)
         echo = echo_ds[()] if load_echo else np.zeros((echo_ds.shape[0], 0), np.complex64)
         echo_channels = f["echo_channels"][()] if ("echo_channels" in f and load_echo) else None
         orbit, attitude = read_platform(f, path)

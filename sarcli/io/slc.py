@@ -33,8 +33,18 @@ import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require, to_jsonable
-from sarcli.io.raw import Attitude, Orbit, Radar
+from sarcli.io.h5common import (
+    atomic_h5,
+    attr_str,
+    dataset,
+    group,
+    open_product,
+    read_mapping,
+    require,
+    to_jsonable,
+    write_mapping,
+)
+from sarcli.io.raw import Attitude, Orbit, Radar, read_platform, read_radar, write_platform, write_radar
 
 PRODUCT_TYPE = "slc"
 SCHEMA_VERSION = "1"
@@ -118,30 +128,10 @@ def _write_meta(f: h5py.File, s: SLC) -> None:
     dataset(g, "fdc_hz", np.asarray(d.fdc_hz, np.float64), units="Hz")
     dataset(g, "fr_hz_per_s", np.asarray(d.fr_hz_per_s, np.float64), units="Hz/s")
     dataset(g, "velocity_mps", np.asarray(d.velocity_mps, np.float64), units="m/s")
-    rg = group(f, "radar")
-    for fld in dataclasses.fields(Radar):
-        v = getattr(s.radar, fld.name)
-        if v is not None:
-            rg.attrs[fld.name] = np.asarray(v, np.float64) if fld.name == "receiver_offsets_m" else v
-    if s.orbit is not None:
-        og = group(f, "orbit")
-        og.attrs["frame"] = s.orbit.frame
-        dataset(og, "time", np.asarray(s.orbit.time, np.float64), units="s")
-        dataset(og, "position", np.asarray(s.orbit.position, np.float64), units="m")
-        dataset(og, "velocity", np.asarray(s.orbit.velocity, np.float64), units="m/s")
-    if s.attitude is not None:
-        ag = group(f, "attitude")
-        dataset(ag, "time", np.asarray(s.attitude.time, np.float64), units="s")
-        for name in ("pitch", "roll", "yaw"):
-            dataset(ag, name, np.asarray(getattr(s.attitude, name), np.float64), units="rad")
+    write_radar(f, s.radar)
+    write_platform(f, s.orbit, s.attitude)
     if s.truth is not None:
-        tg = group(f, "truth")
-        for k in sorted(s.truth):
-            v = s.truth[k]
-            if isinstance(v, str):
-                tg.attrs[k] = v
-            elif v is not None:
-                dataset(tg, k, np.asarray(v))
+        write_mapping(f, "truth", s.truth)
     tg = group(f, "timings")
     for k, v in sorted(s.timings.items()):
         tg.attrs[k] = float(v)
@@ -187,38 +177,12 @@ def read_slc(path: str | os.PathLike, load_image: bool = True) -> SLC:
             raise ProductError(f"{path}: malformed product, image {img.shape} vs axes ({t.size}, {r.size})")
         if "radar" not in f or "doppler" not in f:
             raise ProductError(f"{path}: malformed product, missing 'radar' or 'doppler'")
-        g = f["radar"]
-        kw: dict[str, Any] = {}
-        for fld in dataclasses.fields(Radar):
-            if fld.name in g.attrs:
-                v = g.attrs[fld.name]
-                if fld.name == "receiver_offsets_m":
-                    v = tuple(float(x) for x in np.atleast_1d(v))
-                elif fld.name == "quantization_bits":
-                    v = int(v)
-                else:
-                    v = float(v)
-                kw[fld.name] = v
-        try:
-            radar = Radar(**kw)
-        except TypeError as e:
-            raise ProductError(f"{path}: malformed product, radar attributes incomplete ({e})") from None
+        radar = read_radar(f["radar"], path)
         dg = f["doppler"]
         dop = DopplerUsed(*(require(dg, k, path)[()] for k in
                             ("block_time", "range_m", "fdc_hz", "fr_hz_per_s", "velocity_mps")))
-        orbit = None
-        if "orbit" in f:
-            og = f["orbit"]
-            orbit = Orbit(og["time"][()], og["position"][()], og["velocity"][()], attr_str(og, "frame", "ECI"))
-        attitude = None
-        if "attitude" in f:
-            ag = f["attitude"]
-            attitude = Attitude(*(ag[k][()] for k in ("time", "pitch", "roll", "yaw")))
-        truth = None
-        if "truth" in f:
-            tg = f["truth"]
-            truth = {k: tg[k][()] for k in tg}
-            truth.update({k: attr_str(tg, k) for k in tg.attrs})
+        orbit, attitude = read_platform(f, path)
+        truth = read_mapping(f["truth"]) if "truth" in f else None
         timings = dict(f["timings"].attrs) if "timings" in f else {}
         params = json.loads(attr_str(f, "parameters") or "{}")
         return SLC(

@@ -137,10 +137,9 @@ def focus(
     from sarcli.focus.quality import image_statistics
     from sarcli.io.slc import read_slc
 
-    full = read_slc(output)
-    a, b = max(0, full.first_full_line), min(full.image.shape[0], full.last_full_line + 1)
-    stats = image_statistics(full.image[a:b] if b > a else full.image) if np.any(full.image) else {}
+    stats = _statistics(output, image_statistics)
     if geotiff or geotiff_slant or quicklook:
+        full = read_slc(output)
         tags = {"source_product": output.name, "algorithm": algorithm, "doppler": how}
         if geotiff_slant:
             from sarcli.focus.geocode import write_slant_geotiff
@@ -187,6 +186,22 @@ def focus(
         for k, v in products.items():
             if k not in ("slc", "crs"):
                 info(f"wrote {v}")
+
+
+def _statistics(path: Path, fn) -> dict:
+    """Image statistics over the fully focused lines, read in row blocks (bounded memory)."""
+    from sarcli.io.h5common import open_product
+
+    with open_product(path, "slc") as f:
+        ds = f["image"]
+        a = int(f.attrs.get("first_full_line", 0))
+        b = int(f.attrs.get("last_full_line", ds.shape[0] - 1)) + 1
+        if b <= a:
+            a, b = 0, ds.shape[0]
+        try:
+            return fn(ds[c:min(b, c + 1024)] for c in range(a, b, 1024))
+        except SarcliError:
+            return {}
 
 
 def _inputs(raw_path: Path, doppler: Path | None) -> tuple:
