@@ -121,7 +121,7 @@ def _sgn(x):
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, energy, pairs):
+def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im, energy, pairs):
     # x is the echo viewed as float32 (n_lines, 2 n_samples): interleaved re, im (SIMD-friendly).
     # Azimuth blocks in parallel; inside a block the lines are streamed in memory order (line m and
     # m+1 whole, line m+1 is still in cache for the next pair) with one accumulator per range block.
@@ -131,7 +131,7 @@ def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, en
     nrb = samp0.shape[0]
     for ib in prange(nab):
         m0 = line0[ib]
-        m1 = m0 + nlines[ib] - 1
+        m1 = m0 + nlines[ib] - lag
         cr = np.zeros(nrb)
         ci = np.zeros(nrb)
         en = np.zeros(nrb)
@@ -140,7 +140,7 @@ def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, en
                 # slices start at 0, so numba can drop the negative-index wraparound test and the
                 # loops vectorize (2.6x faster than indexing the whole line from k0)
                 n = nsamp[jb]
-                a = x[m + 1, 2 * samp0[jb]:2 * (samp0[jb] + n)]
+                a = x[m + lag, 2 * samp0[jb]:2 * (samp0[jb] + n)]
                 b = x[m, 2 * samp0[jb]:2 * (samp0[jb] + n)]
                 sr = np.float32(0.0)
                 si = np.float32(0.0)
@@ -170,25 +170,26 @@ def _lag1_kernel(x, line0, nlines, samp0, nsamp, sign_mode, corr_re, corr_im, en
             corr_re[ib, jb] = cr[jb]
             corr_im[ib, jb] = ci[jb]
             energy[ib, jb] = en[jb]
-            pairs[ib, jb] = (m1 - m0) * nsamp[jb]
+            pairs[ib, jb] = max(m1 - m0, 0) * nsamp[jb]
 
 
-def _grid(shape: tuple[int, int], az_block: int, rg_block: int):
+def _grid(shape: tuple[int, int], az_block: int, rg_block: int, lag: int = 1):
     n_lines, n_samples = shape
-    if n_lines < 2:
-        raise SarcliError(f"need at least 2 azimuth lines for a lag-1 correlation, got {n_lines}")
+    if n_lines < lag + 1:
+        raise SarcliError(f"need at least {lag + 1} azimuth lines for a lag-{lag} correlation, got {n_lines}")
     l0, nl = block_edges(n_lines, az_block)
     s0, ns = block_edges(n_samples, rg_block)
-    # a trailing one-line block has no pair: merge it into the previous block
-    if nl[-1] < 2 and nl.size > 1:
+    # a trailing block too short for a pair: merge it into the previous block
+    if nl[-1] < lag + 1 and nl.size > 1:
         nl[-2] += nl[-1]
         l0, nl = l0[:-1], nl[:-1]
     return l0, nl, s0, ns
 
 
 def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 128,
-                      estimator: str = "cde") -> BlockCorrelation:
-    """Lag-1 azimuth correlation sums per block (numba). ``estimator`` is "cde" or "sde".
+                      estimator: str = "cde", lag: int = 1) -> BlockCorrelation:
+    """Lag-``lag`` azimuth correlation sums per block (numba). ``estimator`` is "cde" or "sde".
+    (The CDE uses lag 1; longer lags serve MLBF, whose phase is then ``lag`` times larger.)
 
     Default block (2048 azimuth x 128 range) is the seed paper's. NaN/inf input raises SarcliError.
     """
@@ -199,11 +200,13 @@ def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 12
         raise SarcliError(f"echo must be 2-D (azimuth, range), got shape {h.shape}")
     if h.dtype != np.complex64:
         h = h.astype(np.complex64)
-    l0, nl, s0, ns = _grid(h.shape, az_block, rg_block)
+    if lag < 1:
+        raise SarcliError(f"correlation lag must be >= 1, got {lag}")
+    l0, nl, s0, ns = _grid(h.shape, az_block, rg_block, lag)
     shp = (l0.size, s0.size)
     cr, ci, en = np.zeros(shp), np.zeros(shp), np.zeros(shp)
     pr = np.zeros(shp, np.int64)
-    _lag1_kernel(h.view(np.float32), l0, nl, s0, ns, estimator == "sde", cr, ci, en, pr)
+    _lag_kernel(h.view(np.float32), l0, nl, s0, ns, estimator == "sde", lag, cr, ci, en, pr)
     if estimator == "sde" or not (np.isfinite(en).all() and np.isfinite(cr).all() and np.isfinite(ci).all()):
         # every sample enters some block energy, so a NaN/inf input shows up there for free (CDE);
         # the sign estimator maps NaN to 0 and needs the explicit pass
@@ -212,21 +215,21 @@ def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 12
 
 
 def block_correlation_numpy(echo: np.ndarray, az_block: int = 2048, rg_block: int = 128,
-                            estimator: str = "cde") -> BlockCorrelation:
+                            estimator: str = "cde", lag: int = 1) -> BlockCorrelation:
     """Plain-numpy reference of :func:`block_correlation` (same block grid)."""
     h = np.asarray(echo).astype(np.complex128)
     if estimator == "sde":
         h = np.sign(h.real) + 1j * np.sign(h.imag)
-    l0, nl, s0, ns = _grid(h.shape, az_block, rg_block)
+    l0, nl, s0, ns = _grid(h.shape, az_block, rg_block, lag)
     corr = np.zeros((l0.size, s0.size), complex)
     en = np.zeros(corr.shape)
     pr = np.zeros(corr.shape, np.int64)
     for i, (a, na) in enumerate(zip(l0, nl, strict=True)):
         for j, (b, nb) in enumerate(zip(s0, ns, strict=True)):
             blk = h[a:a + na, b:b + nb]
-            corr[i, j] = np.sum(blk[1:] * np.conj(blk[:-1]))
-            en[i, j] = 0.5 * np.sum(np.abs(blk[1:]) ** 2 + np.abs(blk[:-1]) ** 2)
-            pr[i, j] = (na - 1) * nb
+            corr[i, j] = np.sum(blk[lag:] * np.conj(blk[:-lag]))
+            en[i, j] = 0.5 * np.sum(np.abs(blk[lag:]) ** 2 + np.abs(blk[:-lag]) ** 2)
+            pr[i, j] = max(na - lag, 0) * nb
     return BlockCorrelation(corr, en, pr, l0, nl, s0, ns, estimator)
 
 
