@@ -151,3 +151,26 @@ def geometric_correction_reference(img: PolarImage, ranges: np.ndarray, azimuths
     out = bilinear(img.data, fi, fj)
     out *= np.exp(-1j * 4 * np.pi * (r0 - rc) / wavelength_m).astype(np.complex64)
     return out, np.isfinite(fi) & np.isfinite(fj)
+
+
+def aperture_gain(prof: RangeProfiles, antenna_length_m: float, ranges: np.ndarray, azimuths: np.ndarray,
+                  azimuth_window: str = "hamming") -> np.ndarray:
+    """Per-pixel amplitude correction (n_r, n_x) that puts DF on BP's normalization.
+
+    DF divides by the taper sum over the whole rail, but a scatterer at (x, R0) is seen only from its
+    synthetic aperture ``[a, b]`` = rail ∩ beam footprint ``|x_i - x| <= lam R0/(2 L_x)``; BP divides by
+    the taper sum over [a, b] and scales by ``(b - a)/min(X, lam R0/L_x)`` where a rail end cuts it.
+    The gain ``sum_rail w / sum_[a,b] w * (b - a)/min(X, lam R0/L_x)`` is 1 in region II and makes the
+    stitched ``auto`` image continuous where DF takes over in region I; 0 where no stop sees the pixel.
+    """
+    x = prof.positions_m
+    w = stop_weights(prof, azimuth_window)
+    cs = np.concatenate([[0.0], np.cumsum(w)])
+    half = prof.wavelength_m / (2 * antenna_length_m) * np.asarray(ranges, np.float64)[:, None]
+    px = np.asarray(azimuths, np.float64)[None, :]
+    a, b = np.maximum(x[0], px - half), np.minimum(x[-1], px + half)
+    s = cs[np.searchsorted(x, b, "right")] - cs[np.searchsorted(x, a, "left")]
+    nominal = np.minimum(x[-1] - x[0], 2 * half)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        g = np.where((s > 0) & (b >= a), cs[-1] / s * np.where(nominal > 0, (b - a) / nominal, 1.0), 0.0)
+    return g.astype(np.float32)

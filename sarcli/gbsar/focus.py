@@ -18,7 +18,7 @@ import numpy as np
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.backprojection import backproject
-from sarcli.gbsar.deramp import focus_df, geometric_correction
+from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
 from sarcli.gbsar.rangecomp import RangeProfiles, range_compress
 from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
@@ -99,11 +99,12 @@ def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
     """DF with range and azimuth FFTs ``df_oversample`` times Table 1's sizes (finer polar grid for the
-    bilinear geometric correction; 1 = the paper's N_Rfft x N_xfft)."""
+    bilinear geometric correction; 1 = the paper's N_Rfft x N_xfft), on BP's amplitude normalization."""
     prof = range_compress(scan, pol, opts.range_window, opts.df_oversample, opts.max_range_m)
     n = opts.n_xfft or next_pow2(scan.rail_position.size) * opts.df_oversample
     pol_img = focus_df(prof, n, opts.azimuth_window)
     part, cov = geometric_correction(pol_img, grid.ranges[rows], grid.azimuths, prof.wavelength_m)
+    part *= aperture_gain(prof, scan.antenna.length_azimuth_m, grid.ranges[rows], grid.azimuths, opts.azimuth_window)
     return part, cov, n
 
 
