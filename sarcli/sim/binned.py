@@ -42,21 +42,24 @@ def chirp_filter(radar, q: int, nfft: int) -> tuple[np.ndarray, int]:
 def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int, tick=None) -> None:
     """Add the echoes of the targets in ``args`` (``stripmap.kernel_args`` layout) to ``out`` (n_ch, lines, n).
 
-    ``tick(n)`` (optional) is called after each block of n lines."""
+    ``tick(n)`` (optional) is called after each block of n lines. The grid is allocated at the FFT
+    length (no padding copy) and held in complex64, like the FFTs: the method's own error (about
+    -31 dB) is far above single precision."""
     n_ch, n_lines, n_s = out.shape
     fq = q * radar.range_sampling_rate_hz
     m = int(math.floor(0.5 * radar.pulse_length_s * fq))
     n_grid = q * (n_s - 1) + 2 * m + 2
     nfft = scipy.fft.next_fast_len(n_grid + 2 * m, real=False)
-    spec, _ = chirp_filter(radar, q, nfft)
+    spec = chirp_filter(radar, q, nfft)[0].astype(np.complex64)
     x0 = radar.window_start_s * fq - m
     kargs = args[:14] + (fq, x0) + args[18:]
     pick = q * np.arange(n_s) + 2 * m
     for line0 in range(0, n_lines, BLOCK_LINES):
         nb = min(BLOCK_LINES, n_lines - line0)
-        grid = np.zeros((n_ch, nb, n_grid), np.complex128)
-        splat_kernel(grid, line0, *kargs, block)
-        y = scipy.fft.ifft(scipy.fft.fft(grid, nfft, axis=-1) * spec, axis=-1)
-        out[:, line0:line0 + nb, :] += y[..., pick]
+        grid = np.zeros((n_ch, nb, nfft), np.complex64)
+        splat_kernel(grid, line0, n_grid, *kargs, block)
+        y = scipy.fft.fft(grid, axis=-1)
+        y *= spec
+        out[:, line0:line0 + nb, :] += scipy.fft.ifft(y, axis=-1)[..., pick]
         if tick is not None:
             tick(nb)

@@ -171,11 +171,11 @@ def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, 
 
 
 @njit(cache=True, parallel=True)
-def splat_kernel(grid, line0, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
+def splat_kernel(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
                  migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
     """Binned clutter: add a_i G exp(-j 4 pi R_c/lam) at fractional delay bin x = 2 R_env/c * fq - x0 of
-    grid (n_channels, lines line0.., L), split linearly between the two neighbouring bins."""
-    n_ch, n_lines, n_l = grid.shape
+    grid (n_channels, lines line0.., >= n_l), split linearly between the two neighbouring bins < n_l."""
+    n_ch, n_lines, _ = grid.shape
     n_t = tp.shape[0]
     n_blocks = (n_lines + block - 1) // block
     for b in prange(n_blocks):
@@ -230,10 +230,10 @@ def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_of
             out[c, ks[:, None], n[None, :]] += np.where(inside, sig, 0)
 
 
-def splat_reference(grid, line0, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
+def splat_reference(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
                     migrate, pattern, laz, lel):
     """Plain-numpy reference of :func:`splat_kernel` (same arguments, no block)."""
-    n_ch, n_lines, n_l = grid.shape
+    n_ch, n_lines, _ = grid.shape
     for i in range(tp.shape[0]):
         ks = np.arange(max(k0[i], line0), min(k1[i], line0 + n_lines))
         if ks.size == 0:

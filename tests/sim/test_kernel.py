@@ -95,8 +95,9 @@ def test_splat_kernel_matches_numpy_reference(orbit_scene):
                          * sc.radar.range_sampling_rate_hz - 700.0) + args[18:]
     a = np.zeros((2, 120, 4000), np.complex128)
     b = np.zeros_like(a)
-    splat_kernel(a, 50, *kargs, 16)
-    splat_reference(b, 50, *kargs)
+    splat_kernel(a, 50, 3900, *kargs, 16)
+    splat_reference(b, 50, 3900, *kargs)
+    assert np.all(a[..., 3900:] == 0)
     assert np.abs(b).max() > 0.1 and np.max(np.abs(a - b)) < 1e-7 * np.abs(b).max()  # float64 phase floor
 
 
