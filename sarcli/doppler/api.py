@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from sarcli.doppler import ambiguity as amb
-from sarcli.doppler.cde import block_correlation, check_finite, wrap_frequency
+from sarcli.doppler.cde import block_correlation, wrap_frequency
 from sarcli.doppler.dataonly import combine_estimates, mlbf, mlcc
 from sarcli.doppler.model import DopplerModel
 from sarcli.doppler.polyfit import Poly2D, fit_poly2d
@@ -71,12 +71,14 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                      n_nodes: int | None = None, exact_attitude: bool = True, height_m: float | None = None,
                      half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
                      min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
-                     mapdrift_segments: int = 4, dataonly_rg_block: int | None = None) -> DopplerModel:
+                     mapdrift_segments: int = 4, dataonly_rg_block: int | None = None,
+                     max_lines: int = 4096) -> DopplerModel:
     """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
 
     ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
     1-sigma error of the geometric centroid (default: Radarsat-1's 0.03 deg pitch knowledge, ~140 Hz);
-    it sets the orbit route's ambiguity confidence together with the block scatter.
+    it sets the orbit route's ambiguity confidence together with the block scatter. The data-only
+    ambiguity and map-drift work on the central ``max_lines`` lines (bounded memory on full scenes).
     """
     for name, val, allowed in (("estimator", estimator, ESTIMATORS), ("ambiguity", ambiguity, AMBIGUITY_MODES),
                                ("fr_method", fr_method, FR_METHODS), ("fdc_model", fdc_model, FDC_MODELS)):
@@ -84,7 +86,6 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
             raise SarcliError(f"unknown {name} {val!r}; choose one of {', '.join(allowed)}")
     if az_block < 2 or rg_block < 1:
         raise SarcliError(f"block size must be at least 2 lines x 1 sample, got {az_block} x {rg_block}")
-    check_finite(raw.echo, "echo")
     radar = raw.radar
     prf, lam = radar.prf_hz, radar.wavelength_m
     n_lines, n_samples = raw.echo.shape
@@ -99,7 +100,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                                   height_m=height_m, half_tolerance=half_tolerance, orbit_sigma_hz=orbit_sigma_hz,
                                   noise_sigmas=noise_sigmas, min_quality=min_quality, outlier_sigma=outlier_sigma,
                                   velocity_guess_mps=velocity_guess_mps, mapdrift_segments=mapdrift_segments,
-                                  dataonly_rg_block=dataonly_rg_block)
+                                  dataonly_rg_block=dataonly_rg_block, max_lines=max_lines)
 
     # 1. baseband centroid per block
     data, s_off = _data_for(raw, estimator)
@@ -145,8 +146,9 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
 
     def run_data_only():
         if not data_only and _can_compress(raw):
-            data_only.extend([mlcc(raw.echo, radar, fbb_scene, dataonly_rg_block, raw.replica),
-                              mlbf(raw.echo, radar, fbb_scene, dataonly_rg_block, raw.replica)])
+            sub = _central_lines(raw.echo, max_lines)
+            data_only.extend([mlcc(sub, radar, fbb_scene, dataonly_rg_block, raw.replica),
+                              mlbf(sub, radar, fbb_scene, dataonly_rg_block, raw.replica)])
         return combine_estimates(data_only)
 
     if ambiguity_value is not None:
@@ -223,7 +225,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
             fit_info["fr_grid_fit_max_rel"] = float(np.max(np.abs(fr_poly(GR, GT) / gf - 1.0)))
     if fmethod == "mapdrift":
         fr_poly, fr_blk, fr_info["mapdrift"] = _mapdrift(raw, fdc_poly, geo, Rg, T, velocity_guess_mps,
-                                                         mapdrift_segments)
+                                                         mapdrift_segments, max_lines)
     elif fmethod == "nominal":
         v = radar.platform_velocity_mps or velocity_guess_mps
         fr_blk = -2.0 * v**2 / (lam * Rg)
@@ -269,16 +271,24 @@ def _model_grid(raw: RawProduct, n_r: int = 24, n_t: int = 8) -> tuple[np.ndarra
     return R, T
 
 
-def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int):
-    """Map-drift rate per range segment over the whole azimuth extent; linear fit in range of the
-    segments that converged to within 30 % of their start value."""
+def _central_lines(echo: np.ndarray, max_lines: int) -> np.ndarray:
+    """The central ``max_lines`` lines of the echo (a view)."""
+    n = echo.shape[0]
+    a = max(0, (n - max_lines) // 2)
+    return echo[a:a + max_lines]
+
+
+def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int, max_lines: int):
+    """Map-drift rate per range segment over the central ``max_lines`` lines; linear fit in range of
+    the segments that converged to within 30 % of their start value (constant in time)."""
     from sarcli.doppler.mapdrift import map_drift
     from sarcli.doppler.rangecomp import range_compress_valid
 
     radar = raw.radar
-    rc, valid = range_compress_valid(raw.echo, radar, raw.replica)
+    a0 = max(0, (raw.echo.shape[0] - max_lines) // 2)
+    rc, valid = range_compress_valid(_central_lines(raw.echo, max_lines), radar, raw.replica)
     dr = C / (2.0 * radar.range_sampling_rate_hz)
-    t_c = float(np.mean(raw.azimuth_time))
+    t_c = float(np.mean(raw.azimuth_time[a0:a0 + rc.shape[0]]))
     edges = np.linspace(0, rc.shape[1], max(1, n_seg) + 1).astype(int)
     rng, frs, info = [], [], []
     for a, b in zip(edges[:-1], edges[1:], strict=True):
