@@ -23,6 +23,7 @@ pulse being centred on its delay) and the azimuth (pulse) time of its centre lin
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -72,14 +73,19 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                      half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
                      min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
                      mapdrift_segments: int = 4, dataonly_rg_block: int | None = None,
-                     max_lines: int = 4096) -> DopplerModel:
+                     max_lines: int = 4096, progress: Callable[[str], None] | None = None) -> DopplerModel:
     """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
 
     ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
     1-sigma error of the geometric centroid (default: Radarsat-1's 0.03 deg pitch knowledge, ~140 Hz);
     it sets the orbit route's ambiguity confidence together with the block scatter. The data-only
     ambiguity and map-drift work on the central ``max_lines`` lines (bounded memory on full scenes).
+    ``progress(stage)`` is called after each of the 5 stages (for a progress bar).
     """
+    def step(stage: str) -> None:
+        if progress is not None:
+            progress(stage)
+
     for name, val, allowed in (("estimator", estimator, ESTIMATORS), ("ambiguity", ambiguity, AMBIGUITY_MODES),
                                ("fr_method", fr_method, FR_METHODS), ("fdc_model", fdc_model, FDC_MODELS)):
         if val not in allowed:
@@ -120,6 +126,8 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     if estimator == "sde":
         sum_corr = np.sum(np.where(valid, bc.phase_rho() * bc.pairs, 0))
     fbb_scene = float(wrap_frequency(prf * np.angle(sum_corr) / (2 * np.pi), prf))
+
+    step("baseband centroid")
 
     # 2. unwrap
     fu = amb.unwrap_blocks(np.where(valid, fbb, np.nan), w, prf, Rg, T)
@@ -177,6 +185,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         res = amb.resolve(fbb, fu, fbb_scene, w, prf, half_tolerance)
         source, conf = "none", 0.0
     fdc_abs = fbb + res.block_ambiguity * prf
+    step("ambiguity")
 
     # 4. 2-D fit with outlier flags. With an orbit the geometric model gives the SHAPE of the centroid
     # over the scene (exact to < 0.001 Hz) and the data its offset: the blocks fit a low-order residual
@@ -198,6 +207,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         fdc_poly, outl = fit_poly2d(Rg, T, fdc_abs, w, fit_degree, k_sigma=outlier_sigma, floor=0.002 * prf,
                                     points_per_coef=2)
     outl = outl.reshape(fbb.shape)
+    step("fit")
 
     # 5. Doppler rate
     fr_blk, fr_seed, look_seed, rho_seed = (np.full(fbb.shape, np.nan) for _ in range(4))
@@ -232,6 +242,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         fr_poly, _ = fit_poly2d(GR, GT, -2.0 * v**2 / (lam * GR), np.ones_like(GR), model_degree, k_sigma=np.inf)
         fr_info["nominal_velocity_mps"] = v
 
+    step("Doppler rate")
     r_c = radar.first_range_m + 0.5 * (n_samples - 1) * C / (2.0 * radar.range_sampling_rate_hz)
     t_c = float(0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1]))
     geo_cmp = {}
@@ -260,6 +271,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         "fr_seed_hz_per_s": fr_seed.ravel(), "look_seed_rad": look_seed.ravel(), "range_seed_m": rho_seed.ravel(),
         "outlier": outl.ravel(),
     }
+    step("summary")
     return DopplerModel(fdc_poly, fr_poly, prf, lam, blocks, summary, params)
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info
+from sarcli.cli.common import emit_json, info, progress_bar
 from sarcli.errors import SarcliError
 
 JSON_BLOCK_KEYS = ("range_m", "azimuth_time_s", "fdc_baseband_hz", "quality", "ambiguity", "fdc_hz", "fr_hz_per_s",
@@ -60,11 +60,13 @@ def doppler(
     from sarcli.io.doppler_product import write_doppler
     from sarcli.io.raw import read_raw
 
+    degrees = _degrees(fit_degree, "--fit-degree")
     raw = read_raw(raw_path)
-    model = estimate_doppler(raw, az_block=az_block, rg_block=rg_block, estimator=estimator, ambiguity=ambiguity,
-                             ambiguity_value=ambiguity_value, fr_method=fr_method, fdc_model=fdc_model,
-                             fit_degree=_degrees(fit_degree, "--fit-degree"), n_nodes=n_nodes,
-                             exact_attitude=not small_angle)
+    with progress_bar(5, label="doppler") as bar:
+        model = estimate_doppler(raw, az_block=az_block, rg_block=rg_block, estimator=estimator,
+                                 ambiguity=ambiguity, ambiguity_value=ambiguity_value, fr_method=fr_method,
+                                 fdc_model=fdc_model, fit_degree=degrees, n_nodes=n_nodes,
+                                 exact_attitude=not small_angle, progress=lambda _stage: bar.update(1))
     if output is not None:
         write_doppler(output, model, inputs=(raw_path,))
     if plot is not None:
