@@ -93,10 +93,16 @@ def detect_pair(pair: Pair, knobs: CfarKnobs = CfarKnobs()) -> tuple[list[Candid
                   pair.baseline_m, knobs)
 
 
-def _window(pair: Pair, c: Candidate, margin_rows: int = 24, margin_cols: int = 6) -> tuple[slice, slice]:
+#: sub-image margins (lines, range samples) around a detected cluster: estimation keeps few columns
+#: (less clutter in the slow-time signal), compensation takes more (the smear's range sidelobes)
+ESTIMATION_MARGINS = (24, 6)
+COMPENSATION_MARGINS = (48, 24)
+
+
+def _window(pair: Pair, c: Candidate, margins: tuple[int, int] = ESTIMATION_MARGINS) -> tuple[slice, slice]:
     n, m = pair.z0.shape
-    return (slice(max(0, c.row_start - margin_rows), min(n, c.row_stop + margin_rows)),
-            slice(max(0, c.col_start - margin_cols), min(m, c.col_stop + margin_cols)))
+    return (slice(max(0, c.row_start - margins[0]), min(n, c.row_stop + margins[0])),
+            slice(max(0, c.col_start - margins[1]), min(m, c.col_stop + margins[1])))
 
 
 @dataclass
@@ -196,7 +202,7 @@ def compensate(pair: Pair, res: MoverResult, method: str = "exact") -> np.ndarra
     mover, R*sqrt(1 - R'^2/Vp^2) (estimate.py), to the stationary equivalent's closest range, so
     the re-compressed mover is one column wide like a stationary point (no residual migration).
     """
-    rows, cols = res.rows, res.cols
+    rows, cols = _window(pair, res.candidate, COMPENSATION_MARGINS)
     s0 = decompress(pair.slc0, pair.z0, rows, cols)
     eta = np.asarray(pair.slc0.azimuth_time, np.float64) - pair.t_ref
     shift = int(pair.slc0.parameters.get("shift_lines", 0))

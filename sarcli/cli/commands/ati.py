@@ -152,6 +152,18 @@ def estimate_cmd(
         emit_json(movers)
 
 
+def _true_window(pair, res, half_rows: int = 90, half_cols: int = 3) -> tuple[slice, slice]:
+    """Rows/columns around the mover's estimated true position (where the compensation puts it)."""
+    import numpy as np
+
+    t = pair.slc0.azimuth_time
+    row = int(np.argmin(np.abs(t - (pair.t_ref + res.estimate.y0_m / pair.platform.speed))))
+    col = int(np.argmin(np.abs(pair.slc0.slant_range - math.hypot(res.estimate.x0_m, pair.platform.height))))
+    n, m = pair.z0.shape
+    return (slice(max(0, row - half_rows), min(n, row + half_rows + 1)),
+            slice(max(0, col - half_cols), min(m, col + half_cols + 1)))
+
+
 def _truth_movers(raw) -> list[dict]:
     tab = (raw.truth or {}).get("targets")
     if tab is None:
@@ -207,8 +219,8 @@ def compensate_cmd(
         movers.append(d)
         comp = compensate(pair, res, method)
         after = comp if after is pair.z0 else after + (comp - pair.z0)  # several movers: add each change
-        rows_all = slice(0, t.size)
-        r, c, cut = psf_cut(after, rows_all, res.cols)
+        win_r, win_c = _true_window(pair, res)
+        r, c, cut = psf_cut(after, win_r, win_c)
         rb, cb, cut_b = psf_cut(pair.z0, res.rows, res.cols)
         rec = {"id": d["id"], "method": method, "peak_y_local_m": y_of(peak_position(cut, r)),
                "peak_range_m": float(pair.slc0.slant_range[c]), "width_3db_m": width_3db(cut, r) * dt * vp,
@@ -218,7 +230,7 @@ def compensate_cmd(
                "estimated_y_local_m": d["y_local_m"]}
         if compare_conventional:
             conv = compensate(pair, res, "conventional")
-            rc, cc, cut_c = psf_cut(conv, rows_all, res.cols)
+            rc, cc, cut_c = psf_cut(conv, win_r, win_c)
             rec["conventional_peak_y_local_m"] = y_of(peak_position(cut_c, rc))
         movers_truth = [m for m in truth if m["moving"]]
         if movers_truth:
@@ -265,12 +277,13 @@ def _pngs(folder: Path, pair, res, after, conv, mid: int, y_of) -> None:
     prof = {}
     _, _, cb = psf_cut(pair.z0, res.rows, res.cols)
     prof["before"] = (ys, cb)
-    _, _, ca = psf_cut(after, slice(0, n), res.cols)
+    win_r, win_c = _true_window(pair, res)
+    _, _, ca = psf_cut(after, win_r, win_c)
     prof["proposed"] = (ys, ca)
     if conv is not None:
         write_quicklook(folder / f"mover{mid}_conventional.png", conv[rows, cols], title="conventional compensation",
                         **kw)
-        _, _, cc = psf_cut(conv, slice(0, n), res.cols)
+        _, _, cc = psf_cut(conv, win_r, win_c)
         prof["conventional"] = (ys, cc)
     psf_plot({k: (y[rows], v[rows]) for k, (y, v) in prof.items()}, folder / f"mover{mid}_psf.png",
              f"azimuth PSF, mover {mid}")
