@@ -41,16 +41,3 @@ def ps_series(stack: np.ndarray, rows: np.ndarray, cols: np.ndarray, wavelength_
     z = stack[:, rows, cols].T  # (n_ps, N)
     ph = np.unwrap(np.angle(z * np.conj(z[:, :1])), axis=1)
     return ph.astype(np.float32), (-ph * wavelength_m / (4 * np.pi) * 1e3).astype(np.float32)
-
-
-def normalized_difference(hh: np.ndarray, vv: np.ndarray, window: int = 1) -> np.ndarray:
-    """Polarimetric normalized difference ``(|HH|^2 - |VV|^2) / (|HH|^2 + |VV|^2)`` in [-1, 1] (seed 003),
-    powers averaged over a ``window`` x ``window`` boxcar first; NaN where both are zero."""
-    from scipy.ndimage import uniform_filter
-
-    if window < 1:
-        raise SarcliError("the polarimetric window must be >= 1 pixel")
-    ph = uniform_filter(np.abs(hh).astype(np.float64) ** 2, window)
-    pv = uniform_filter(np.abs(vv).astype(np.float64) ** 2, window)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(ph + pv > 0, (ph - pv) / (ph + pv), np.nan).astype(np.float32)

@@ -9,9 +9,10 @@ import pytest
 from sarcli.errors import SarcliError
 from sarcli.gbsar.focus import FocusOptions, Grid, image_from_scan
 from sarcli.gbsar.interferometry import interfere
+from sarcli.gbsar.polarimetry import normalized_difference
 from sarcli.gbsar.scene import scene_from_dict
 from sarcli.gbsar.simulate import simulate
-from sarcli.gbsar.timeseries import normalized_difference, ps_series, select_ps, temporal_coherence
+from sarcli.gbsar.timeseries import ps_series, select_ps, temporal_coherence
 from tests.gbsar.helpers import scene_dict
 
 H = 21.0  # antenna height above the lawn (seed 003)

@@ -434,7 +434,7 @@ def polarimetry_cmd(
 
       sarcli gbsar polarimetry image.h5 --png nd.png --geotiff nd.tif
     """
-    from sarcli.gbsar.timeseries import normalized_difference
+    from sarcli.gbsar.polarimetry import normalized_difference
 
     img = _load_image(image)
     nd = normalized_difference(img.pol("HH"), img.pol("VV"), window)
