@@ -162,9 +162,18 @@ def section_hermite(out: dict, raw) -> str:
     sv = StateVectors(o.time, o.position, o.velocity, o.frame, raw.epoch_utc)
     tt = np.linspace(-5.0, 5.0, 100_000)
     rows, data = [], []
+    # fdc sensitivity to the order: the Doppler of the (fixed) beam-centre targets seen from the
+    # states interpolated with n nodes; fr: the exact rate with n nodes
+    from orbit import geometry as og
+
+    r0, v0, _ = sv.interpolate(t)
+    a = raw.attitude
+    p = og.target_from_look_plane(r0, v0, rho, np.interp(t, a.time, a.pitch), np.interp(t, a.time, a.yaw))
+    lam = raw.radar.wavelength_m
     for n in (2, 3, 4, 6, 8, 10, 12, 15):
         g = OrbitGeometry.from_raw(raw, n_nodes=n)
-        ef = float(np.max(np.abs(g.fdc_vector(rho, t) - tf[::32])))
+        rn, vn, _ = sv.interpolate(t, n)
+        ef = float(np.max(np.abs(og.doppler_hz(rn, og.relative_velocity_eci(rn, vn), p, lam) - tf[::32])))
         er = float(np.max(np.abs(g.fr_exact(rho, t, tf[::32]) / tr[::32] - 1)))
         ti = best_time(lambda n=n: sv.interpolate(tt, n), repeat=3)
         rows.append([n, ef, er, ti / tt.size * 1e9])

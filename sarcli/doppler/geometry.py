@@ -7,9 +7,9 @@ with L the unit line of sight satellite -> target and v_rel the satellite veloci
 
 Full vector model (``fdc_vector``): at azimuth time eta, the target p is the point of the ellipsoid
 (+ height) at slant range rho in the beam-centre plane (p - r) . w = 0, w = Q R e_x the control
-frame's along-track axis (attitude pitch/yaw; flight frame Q from the ECI state, seed eq. 2-3:
-``orbit.geometry.target_from_look_plane``). p is then taken Earth-fixed and the Doppler is evaluated
-exactly in ECEF (``orbit.geometry.doppler_hz``).
+frame's along-track axis (attitude pitch/yaw; flight frame Q from the ECI state, seed eq. 2-3), and
+fdc = (2/lam) (v - w_e x r) . (p - r)/rho, exact because (w_e x (p - r)) . (p - r) = 0
+(``orbit.geometry.doppler_from_attitude``).
 
 Closed form (``fdc_closed``, the seed's eq. 6 in our notation): with R Lc expanded to first order in
 pitch pp and yaw py, R Lc = (pp cos g - s py sin g, s sin g, cos g) (s = +1 right-looking), and
@@ -101,15 +101,16 @@ class OrbitGeometry:
         return eci_to_ecef(self.sv_eci.epoch_utc, t, p_eci)
 
     def fdc_vector(self, rho, t) -> np.ndarray:
-        """Full vector model: absolute fdc (Hz) of the beam-centre-plane target at (rho, t)."""
+        """Full vector model: absolute fdc (Hz) of the beam-centre-plane target at (rho, t)
+        (``orbit.geometry.doppler_from_attitude``; it interpolates the orbit with its default order,
+        ``n_nodes`` applies to the rates, where the order matters - see the bench)."""
         rho, t = np.broadcast_arrays(np.asarray(rho, np.float64), np.asarray(t, np.float64))
-        r, v, re, ve, _ = self._states(t)
         pp, py = self.attitude(t)
         try:
-            p = og.target_from_look_plane(r, v, rho, pp, py, self.side, self.height_m, self.exact_attitude)
+            return og.doppler_from_attitude(self.sv_eci, t, rho, self.wavelength, pp, py, self.side,
+                                            self.height_m, self.exact_attitude)
         except OrbitError as e:
             raise SarcliError(f"geometry: {e}") from None
-        return og.doppler_hz(re, ve, self._to_ecef(t, p), self.wavelength)
 
     def _closed_coeffs(self, r, v, pp, py):
         q = flight_frame(r, v)
