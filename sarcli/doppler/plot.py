@@ -7,6 +7,7 @@ import os
 import numpy as np
 
 from sarcli.doppler.model import DopplerModel
+from sarcli.io.images import atomic_path
 
 
 def plot_doppler(path: str | os.PathLike, model: DopplerModel, title: str = "") -> None:
@@ -42,5 +43,6 @@ def plot_doppler(path: str | os.PathLike, model: DopplerModel, title: str = "") 
     fig.colorbar(sc, ax=ax, label="block quality |C|/E", shrink=0.6)
     fig.suptitle(title or (f"fdc {s['fdc_hz']:.1f} Hz (ambiguity {s['ambiguity']}, {s['ambiguity_source']}, "
                            f"confidence {s['ambiguity_confidence']:.2f}), fr {s['fr_hz_per_s']:.2f} Hz/s"))
-    fig.savefig(path, dpi=100)
+    with atomic_path(path, ".png") as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
     plt.close(fig)
