@@ -78,12 +78,12 @@ def routes_on_paper_scene() -> tuple[list, dict]:
     rows = []
     for bin_mode in ("track", "anv"):
         obs, *_ = slow_time(pair, c, bin_mode)
-        for route in ("seed", "exact", "nonlinear"):
-            e = estimate(obs, route)
-            sec = best_time(lambda r=route, o=obs: estimate(o, r), repeat=3)
+        for route, deg in (("seed", 2), ("exact", 2), ("exact", 4), ("nonlinear", 4)):
+            e = estimate(obs, route, degree=deg)
+            sec = best_time(lambda r=route, o=obs, g=deg: estimate(o, r, degree=g), repeat=3)
             rel = _rel(e)
-            rows.append([route, bin_mode, 100 * rel["vy"], 100 * rel["x0"], 100 * rel["y0"], e.vy_mps_sigma,
-                         e.y0_m_sigma, sec])
+            rows.append([f"{route} (deg {deg})", bin_mode, 100 * rel["vy"], 100 * rel["x0"], 100 * rel["y0"],
+                         e.vy_mps_sigma, e.y0_m_sigma, sec])
     res = estimate_mover(pair, c, "exact")
     t = pair.slc0.azimuth_time
     pos = {}
@@ -100,16 +100,16 @@ def routes_synthetic(n: int = 20) -> list:
     from sarcli.ati.estimate import estimate
 
     rows = []
-    for route in ("seed", "exact", "nonlinear"):
+    for route, deg in (("seed", 2), ("exact", 2), ("exact", 4), ("nonlinear", 4)):
         errs, secs = [], []
         for seed in range(n):
             obs = _synth(40.0, seed)
             t0 = time.perf_counter()
-            e = estimate(obs, route)
+            e = estimate(obs, route, degree=deg)
             secs.append(time.perf_counter() - t0)
             errs.append(_rel(e))
         a = {k: np.array([x[k] for x in errs]) for k in ("vy", "x0", "y0")}
-        rows.append([route, *(100 * float(np.mean(a[k])) for k in ("vy", "x0", "y0")),
+        rows.append([f"{route} (deg {deg})", *(100 * float(np.mean(a[k])) for k in ("vy", "x0", "y0")),
                      *(100 * float(np.max(a[k])) for k in ("vy", "x0", "y0")), float(np.median(secs))])
     return rows
 

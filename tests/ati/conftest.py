@@ -7,6 +7,9 @@ ground, platform at height H along +y), one transmitter on the platform, receive
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -51,55 +54,37 @@ def paper():
     return dict(PAPER)
 
 
-SMALL_HEADER = """
-[scene]
-name = "ati_small"
-seed = {seed}
-effects = ["range_migration", "second_channel", "target_motion", "noise"]
+SAMPLE = Path(__file__).resolve().parents[2] / "samples" / "ati_paper.toml"
 
-[radar]
-carrier_frequency_hz = 1.0e9
-prf_hz = 1500.0
-range_sampling_rate_hz = 40.0e6
-chirp_rate_hz_per_s = 3.2e13
-pulse_length_s = 1.0e-6
-n_lines = {n_lines}
-n_samples = {n_samples}
-first_range_m = {first_range}
-look_side = "right"
 
-[antenna]
-length_m = 1.0
-height_m = 0.5
-look_angle_deg = 27.0
-
-[platform]
-type = "linear"
-velocity_mps = 2000.0
-height_m = 10000.0
-
-[second_channel]
-receiver_offset_m = 2.0
-
-[noise]
-snr_db = {snr}
-"""
+def _set(text: str, key: str, value) -> str:
+    out, n = re.subn(rf"^{key} = .*$", f"{key} = {value!r}", text, flags=re.M)
+    assert n == 1, key
+    return out
 
 
 def small_scene(tmp_path, targets=(), clutter=(), snr=20.0, seed=11, n_lines=450, n_samples=160,
                 first_range=11120.0, name="small.toml"):
-    """A reduced ATI scene (B 32 MHz, CPI 0.3 s at 1.5 kHz) written to ``tmp_path/name``.
+    """A reduced ATI scene (B 32 MHz, CPI 0.3 s at 1.5 kHz) written to ``tmp_path/name``: the paper
+    sample's radar, antenna, platform and channels with smaller numbers and the given scatterers.
 
     ``targets``: dicts with x_m, y_m, vx_mps, vy_mps, amplitude; ``clutter``: dicts with x_m, y_m,
     range_extent_m, azimuth_extent_m, sigma0_db, density_per_m2.
     """
-    text = SMALL_HEADER.format(seed=seed, n_lines=n_lines, n_samples=n_samples, first_range=first_range, snr=snr)
+    full = SAMPLE.read_text()
+    head, rest = full.split("[[targets]]", 1)
+    tail = rest[rest.index("[second_channel]"):]
+    for k, v in (("seed", seed), ("prf_hz", 1500.0), ("range_sampling_rate_hz", 40.0e6),
+                 ("chirp_rate_hz_per_s", 3.2e13), ("n_lines", n_lines), ("n_samples", n_samples),
+                 ("first_range_m", first_range)):
+        head = _set(head, k, v)
+    text = head + _set(tail, "snr_db", float(snr))
     for t in targets:
         text += "\n[[targets]]\n" + "".join(f"{k} = {float(v)!r}\n" for k, v in t.items())
     for c in clutter:
         text += "\n[[clutter]]\n" + "".join(f"{k} = {float(v)!r}\n" for k, v in c.items())
     p = tmp_path / name
-    p.write_text(text)
+    p.write_text(text + "\n")
     return p
 
 

@@ -87,7 +87,7 @@ def test_single_channel_product_is_a_clear_error(tmp_path, cli):
 def test_montecarlo_reduced_is_reproducible(tmp_path, scene_file, cli):
     m = dict(x_m=5150.0, y_m=150.0, vx_mps=8.0, vy_mps=20.0, amplitude=1.0)
     scene = scene_file(tmp_path, [m], [], n_lines=300)
-    args = ("ati", "montecarlo", "--scene", str(scene), "--runs", "2", "--snr", "10,20", "--seed", "5", "--json")
+    args = ("ati", "montecarlo", "--scene", str(scene), "--runs", "1", "--snr", "10,20", "--seed", "5", "--json")
     r1, r2 = cli(*args), cli(*args)
     assert r1.exit_code == 0, r1.stderr
     assert r1.stdout == r2.stdout
