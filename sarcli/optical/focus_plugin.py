@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
 
 from sarcli.errors import SarcliError
 from sarcli.focus.algorithms import register
+from sarcli.focus.rda import RdKnobs
 from sarcli.io.raw import RawProduct
 from sarcli.io.slc import SLC, DopplerUsed
 from sarcli.optical import limitations as lim
@@ -20,7 +22,12 @@ _SETTINGS = {"reference_offset_hz", "reference_ratio", "magnification", "remove_
 def focus_optical(raw: RawProduct, doppler=None, channel: int = 0, limitations="all", centre_range_m=None,
                   adc_bits: int = 8, **knobs) -> SLC:
     """Emulated optical image as an SLC. ``doppler`` is not used: the mask follows from the geometry
-    (zero Doppler, rate -2 v^2 / (lam R)), as in the analog processor."""
+    (zero Doppler, rate -2 v^2 / (lam R)), as in the analog processor. The Range-Doppler knobs that
+    ``sarcli focus`` passes to every algorithm (windows, RCMC, ...) do not apply and are recorded as
+    unused; any other unknown name is an error."""
+    rd_knobs = {f.name for f in dataclasses.fields(RdKnobs)}
+    unused = sorted(set(knobs) & rd_knobs)
+    knobs = {k: v for k, v in knobs.items() if k not in rd_knobs}
     unknown = sorted(set(knobs) - _SETTINGS)
     if unknown:
         raise SarcliError(f"unknown optical option(s) {', '.join(unknown)}; known: "
@@ -36,7 +43,7 @@ def focus_optical(raw: RawProduct, doppler=None, channel: int = 0, limitations="
     used = DopplerUsed(block_time=np.array([float(np.mean(out.azimuth_time))]), range_m=out.slant_range,
                        fdc_hz=np.zeros((1, out.slant_range.size)), fr_hz_per_s=fr[None, :],
                        velocity_mps=np.full((1, out.slant_range.size), v))
-    params = {"limitations": sorted(out.limitations), "adc_bits": int(adc_bits),
+    params = {"limitations": sorted(out.limitations), "adc_bits": int(adc_bits), "unused_rd_knobs": unused,
               **{k: (v_ if not isinstance(v_, float) or np.isfinite(v_) else None)
                  for k, v_ in out.design.__dict__.items()},
               **{k: getattr(settings, k) for k in sorted(_SETTINGS)}, **out.report}
