@@ -115,13 +115,14 @@ class MoverResult:
     cols: slice
     x_local_m: float
     y_local_m: float
+    t_ref_s: float = 0.0
 
     def as_dict(self) -> dict:
         e = self.estimate
         out = {"id": self.candidate.id, "vx_mps": e.vx_mps, "vy_mps": e.vy_mps, "x0_m": e.x0_m, "y0_m": e.y0_m,
                "r0_m": e.r0_m, "vx_mps_sigma": e.vx_mps_sigma, "vy_mps_sigma": e.vy_mps_sigma,
                "x0_m_sigma": e.x0_m_sigma, "y0_m_sigma": e.y0_m_sigma, "r0_m_sigma": e.r0_m_sigma,
-               "x_local_m": self.x_local_m, "y_local_m": self.y_local_m,
+               "x_local_m": self.x_local_m, "y_local_m": self.y_local_m, "t_ref_s": self.t_ref_s,
                "vr_mps": e.vr_mps, "ar_mps2": e.ar_mps2, "route": e.route,
                "vy_degenerate": e.vy_degenerate, "ati_phase_rad": e.ati_phase_rad,
                "ati_ambiguous": e.ati_ambiguous or self.candidate.ati_ambiguous,
@@ -161,7 +162,7 @@ def estimate_mover(pair: Pair, c: Candidate, route: str = "exact", unwrap_method
                    bin_mode: str = "track", degree: int = 4) -> MoverResult:
     obs, rows, cols, _ = slow_time(pair, c, bin_mode)
     e = estimate(obs, route, unwrap_method, degree)
-    return MoverResult(c, e, rows, cols, pair.origin_xy[0] + e.x0_m, pair.origin_xy[1] + e.y0_m)
+    return MoverResult(c, e, rows, cols, pair.origin_xy[0] + e.x0_m, pair.origin_xy[1] + e.y0_m, pair.t_ref)
 
 
 def compensation_phase(eta: np.ndarray, e: Estimate, platform: Platform, method: str = "exact") -> np.ndarray:

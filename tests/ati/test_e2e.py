@@ -2,6 +2,7 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ MOVERS = [dict(x_m=5150.0, y_m=-60.0, vx_mps=8.0, vy_mps=10.0, amplitude=10.0),
           dict(x_m=5300.0, y_m=-90.0, vx_mps=4.0, vy_mps=20.0, amplitude=10.0),   # same range bin as the one above
           dict(x_m=5420.0, y_m=0.0, vx_mps=12.0, vy_mps=0.0, amplitude=10.0)]
 P = Platform(10e3, 2000.0, 299792458.0 / 1e9)
+PAPER_SCENE = str(Path(__file__).resolve().parents[2] / "samples" / "ati_paper.toml")
 
 
 def _raw(tmp_path, scene_path, name="raw.h5"):
@@ -74,7 +76,7 @@ def test_mover_leaving_the_scene_is_still_estimated(tmp_path, scene_file, cli):
 
 
 def test_single_channel_product_is_a_clear_error(tmp_path, cli):
-    sc = load_scene("samples/ati_paper.toml")
+    sc = load_scene(PAPER_SCENE)
     raw = simulate(sc)
     raw.echo_channels = None
     raw.radar.receiver_offsets_m = (0.0,)
@@ -102,7 +104,7 @@ def test_montecarlo_reduced_is_reproducible(tmp_path, scene_file, cli):
 @pytest.mark.slow
 def test_montecarlo_paper_bar_reduced(cli):
     """The paper's bar (<= 0.2 % for SNR >= 10 dB), one run per SNR (the bench runs 50)."""
-    r = cli("ati", "montecarlo", "--scene", "samples/ati_paper.toml", "--runs", "1", "--snr", "10,25",
+    r = cli("ati", "montecarlo", "--scene", PAPER_SCENE, "--runs", "1", "--snr", "10,25",
             "--seed", "3", "--json")
     assert r.exit_code == 0, r.stderr
     for e in json.loads(r.stdout)["per_snr"]:
@@ -112,14 +114,14 @@ def test_montecarlo_paper_bar_reduced(cli):
 
 
 def test_bad_snr_spec_is_one_line(cli):
-    r = cli("ati", "montecarlo", "--scene", "samples/ati_paper.toml", "--snr", "5:1:1")
+    r = cli("ati", "montecarlo", "--scene", PAPER_SCENE, "--snr", "5:1:1")
     assert r.exit_code != 0 and "--snr" in r.stderr and "Traceback" not in r.stderr
 
 
 @pytest.mark.slow
 def test_paper_scenario_compensation(tmp_path, cli):
     """Seed 001 at 20 dB: displaced ~-30..-40 m and smeared; after: 0.2 %, one cell, PSF; ~12 m conventional."""
-    raw = _raw(tmp_path, "samples/ati_paper.toml")
+    raw = _raw(tmp_path, PAPER_SCENE)
     out = tmp_path / "comp.h5"
     figs = tmp_path / "figs"
     figs.mkdir()
