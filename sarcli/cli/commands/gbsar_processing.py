@@ -380,20 +380,19 @@ def _seconds_between(a: str, b: str) -> float:
 
 
 def _write_ps_csv(path: Path, img, rows, cols, gamma, phase, disp) -> None:
+    """One line per PS: position, coherence, phase (deg) and LOS displacement (mm) per scan; atomic."""
     import csv as _csv
-    import os
-    import tempfile
+
+    from sarcli.io.images import atomic_path
 
     n = phase.shape[1] if phase.ndim == 2 else 0
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent if str(path.parent) else ".")
-    with os.fdopen(fd, "w", newline="") as fh:
+    with atomic_path(path, ".csv") as tmp, open(tmp, "w", newline="") as fh:
         w = _csv.writer(fh)
         w.writerow(["ps", "azimuth_m", "range_m", "coherence"] + [f"phase_deg_{i}" for i in range(n)]
                    + [f"displacement_mm_{i}" for i in range(n)])
         for k, (r, c) in enumerate(zip(rows, cols, strict=True)):
             w.writerow([k, f"{img.azimuth_m[c]:.3f}", f"{img.range_m[r]:.3f}", f"{gamma[r, c]:.5f}"]
                        + [f"{v:.3f}" for v in np.degrees(phase[k])] + [f"{v:.4f}" for v in disp[k]])
-    os.replace(tmp, path)
 
 
 def _ps_plot(path: Path, img, gamma, rows, cols, t, disp) -> None:
