@@ -189,7 +189,9 @@ def focus_cmd(
         s.pol(p)
     img = image_from_scan(s, opts, pols=pols)
     f = img
+    timings = img.report.pop("seconds")  # wall times stay out of the product (reproducible bytes)
     write_gbsar_image(output, img, parameters=vars(opts), inputs=[scan])
+    img.report["seconds"] = timings
     _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quicklook, f.report)
     if "df_below_limit" in f.report:
         b = f.report["df_below_limit"]
