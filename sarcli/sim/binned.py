@@ -29,14 +29,13 @@ from sarcli.sim.kernel import splat_kernel
 BLOCK_LINES = 256
 
 
-def chirp_filter(radar, q: int, nfft: int) -> tuple[np.ndarray, int]:
-    """(spectrum of c_q divided by the splat response, M)."""
+def chirp_filter(radar, q: int, nfft: int) -> np.ndarray:
+    """Spectrum (nfft bins) of the chirp c_q at q fs divided by the splat response sinc^2(nu)."""
     fq = q * radar.range_sampling_rate_hz
     m = int(math.floor(0.5 * radar.pulse_length_s * fq))
     j = np.arange(-m, m + 1)
     c = np.exp(1j * np.pi * radar.chirp_rate_hz_per_s * (j / fq) ** 2)
-    nu = scipy.fft.fftfreq(nfft)
-    return scipy.fft.fft(c, nfft) / np.sinc(nu) ** 2, m
+    return scipy.fft.fft(c, nfft) / np.sinc(scipy.fft.fftfreq(nfft)) ** 2
 
 
 def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int, tick=None) -> None:
@@ -50,7 +49,7 @@ def add_binned_echo(out: np.ndarray, args: tuple, radar, q: int, block: int, tic
     m = int(math.floor(0.5 * radar.pulse_length_s * fq))
     n_grid = q * (n_s - 1) + 2 * m + 2
     nfft = scipy.fft.next_fast_len(n_grid + 2 * m, real=False)
-    spec = chirp_filter(radar, q, nfft)[0].astype(np.complex64)
+    spec = chirp_filter(radar, q, nfft).astype(np.complex64)
     x0 = radar.window_start_s * fq - m
     kargs = args[:14] + (fq, x0) + args[18:]
     pick = q * np.arange(n_s) + 2 * m

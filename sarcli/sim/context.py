@@ -8,7 +8,7 @@ uniform illumination inside the processed beam, one receive channel, static targ
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,7 +27,6 @@ class SimContext:
     pitch_rad: float = 0.0
     yaw_rad: float = 0.0
     receiver_offsets_m: tuple[float, ...] = (0.0,)
-    notes: dict = field(default_factory=dict)
 
     def rng(self, stream: str) -> np.random.Generator:
         """An independent generator per named stream, all derived from the scene seed."""

@@ -219,9 +219,6 @@ class Scene:
     clutter_model: str = "binned"
     clutter_oversampling: int = 4
 
-    def has(self, effect: str) -> bool:
-        return effect in self.effects
-
 
 def _radar(t: _Table) -> RadarConfig:
     fs = t.num("range_sampling_rate_hz", positive=True)

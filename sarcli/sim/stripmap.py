@@ -55,7 +55,7 @@ def prepare(scene: Scene):
 
 
 def kernel_args(scene: Scene, ctx: SimContext, traj: Trajectory, motion: Motion, axes, rot, ts: TargetSet):
-    """Positional arguments of ``echo_kernel``/``echo_reference`` after ``out`` (without ``block``)."""
+    """Positional arguments of ``echo_kernel``/``echo_reference`` after ``out`` (before ``block``, lines)."""
     ux, ue, _, _ = axes
     rad, ant = scene.radar, scene.antenna
     lam = rad.wavelength_m
