@@ -10,7 +10,8 @@ Procedure for one target (image coordinates: row = azimuth line, col = range sam
    peak to 1/``upsample`` pixel, refined by a parabola through the three samples around the maximum;
 4. the chip is shifted (FFT phase ramp) so that the peak sits on a pixel, and the range and azimuth
    cuts through it are Fourier-interpolated x ``upsample``;
-5. on each cut: IRW = width at half power (-3 dB), main lobe = between the first minima either side,
+5. on each cut: IRW = width at half power (-3 dB), main lobe = between the first minima either side
+   (searched beyond the half-power points, so that noise on a wide lobe is not taken for a minimum),
    PSLR = largest sidelobe / peak (dB), ISLR = sidelobe energy / main-lobe energy (dB) with the
    sidelobes counted out to ``extent`` main-lobe half-widths (null-to-peak distances) either side.
 
@@ -58,7 +59,10 @@ def cut_metrics(cut: np.ndarray, step: float, extent: float = 20.0) -> CutMetric
     irw = (crossing(1) - crossing(-1)) * step
 
     def first_min(direction: int) -> int:
+        # start beyond the half-power point: a noise dip on a wide main lobe is not its first minimum
         i = i0
+        while 0 <= i + direction < p.size and p[i] > half:
+            i += direction
         while 0 <= i + direction < p.size and p[i + direction] <= p[i]:
             i += direction
         return i

@@ -29,10 +29,8 @@ def _doppler_model(raw, shape, doppler_path: Path | None, fdc: float | None, fr:
         r_mid = raw.radar.first_range_m + (shape[1] // 2) * 299792458.0 / (2 * raw.radar.range_sampling_rate_hz)
         return (GeometricDoppler.from_centroid_and_rate(fdc, fr, r_mid, raw.radar.wavelength_m),
                 f"given: fdc {fdc:.1f} Hz, fr {fr:.2f} Hz/s at {r_mid:.0f} m")
-    from sarcli.doppler.api import estimate_doppler
-
-    info("no --doppler given: estimating the Doppler centroid and rate from the data", quiet)
-    return estimate_doppler(raw), "estimated from the data"
+    info("no --doppler given: the Doppler centroid and rate are estimated from the data", quiet)
+    return _LazyDoppler(raw), "estimated from the data"
 
 
 def focus(
@@ -51,6 +49,11 @@ def focus(
     range_band_fraction: float = typer.Option(1.0, "--range-band-fraction", help="Processed part of the chirp "
                                               "band (0..1]."),
     rcmc: str = typer.Option("sinc8", "--rcmc", help="RCMC interpolator: nearest, linear, sinc4, sinc8, sinc16."),
+    rcmc_oversample: int = typer.Option(2, "--rcmc-oversample", help="Range upsampling before RCMC (1 or 2)."),
+    orbit_timing: bool = typer.Option(True, "--orbit-timing/--no-orbit-timing", help="Correct the zero-Doppler "
+                                      "time and phase of the hyperbolic model from the orbit (Earth orbits)."),
+    sets: list[str] = typer.Option(None, "--set", help="KEY=VALUE processing knob for the algorithm "
+                                   "(JSON value, else a string); repeatable. Overrides the options above."),
     src: bool = typer.Option(True, "--src/--no-src", help="Secondary range compression."),
     double: bool = typer.Option(False, "--double", help="Process in complex128 (default complex64)."),
     block_lines: int = typer.Option(4096, "--block-lines", help="Azimuth FFT length per block (memory bound)."),
@@ -96,9 +99,13 @@ def focus(
     knobs = {"range_window": range_window, "azimuth_window": azimuth_window,
              "azimuth_bandwidth_hz": azimuth_bandwidth, "range_bandwidth_fraction": range_band_fraction,
              "rcmc": rcmc, "src": src, "precision": "double" if double else "single", "block_lines": block_lines,
-             "use_replica": replica}
-    make_knobs(**knobs)  # refuse bad values before any work
+             "use_replica": replica, "rcmc_oversample": rcmc_oversample, "orbit_timing": orbit_timing}
     fn = algorithms.get(algorithm)
+    if algorithm in ("rd", "backprojection"):
+        knobs.update(_parse_sets(sets or []))
+        make_knobs(**knobs)  # refuse bad values before any work
+    else:  # a plug-in gets only what the user set for it
+        knobs = _parse_sets(sets or [])
     # the estimator and the non-RD algorithms need the echo in memory; the RD path streams it otherwise
     in_memory = (doppler is None and fdc is None) or algorithm != "rd"
     raw = read_raw(raw_path, load_echo=in_memory)
@@ -107,6 +114,8 @@ def focus(
         raise SarcliError(f"{raw_path}: product has {raw.n_channels} channel(s), channel {channel} requested")
     t0 = time.perf_counter()
     model, how = _doppler_model(raw, shape, doppler, fdc, fr, as_json)
+    if isinstance(model, _LazyDoppler) and algorithm in ("rd", "backprojection"):
+        model.fdc(raw.radar.first_range_m, 0.0)  # these need it: estimate now, timed as the Doppler stage
     t_doppler = time.perf_counter() - t0
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -186,6 +195,46 @@ def focus(
         for k, v in products.items():
             if k not in ("slc", "crs"):
                 info(f"wrote {v}")
+
+
+def _parse_sets(items: list[str]) -> dict:
+    """``["a=1", "b=hamming"]`` -> {"a": 1, "b": "hamming"} (JSON values where they parse)."""
+    import json
+
+    out = {}
+    for it in items:
+        key, eq, val = it.partition("=")
+        if not eq or not key.strip():
+            raise SarcliError(f"--set {it!r}: expected KEY=VALUE")
+        try:
+            out[key.strip()] = json.loads(val)
+        except json.JSONDecodeError:
+            out[key.strip()] = val
+    return out
+
+
+class _LazyDoppler:
+    """Estimates the Doppler from the data on first use (an algorithm that ignores it costs nothing)."""
+
+    def __init__(self, raw):
+        self._raw = raw
+        self._model = None
+
+    def _get(self):
+        if self._model is None:
+            from sarcli.doppler.api import estimate_doppler
+
+            self._model = estimate_doppler(self._raw)
+        return self._model
+
+    def fdc(self, range_m, azimuth_time_s):
+        return self._get().fdc(range_m, azimuth_time_s)
+
+    def fr(self, range_m, azimuth_time_s):
+        return self._get().fr(range_m, azimuth_time_s)
+
+    def __getattr__(self, name):
+        return getattr(self._get(), name)
 
 
 def _statistics(path: Path, fn) -> dict:
