@@ -153,9 +153,30 @@ def geometric_correction_reference(img: PolarImage, ranges: np.ndarray, azimuths
     return out, np.isfinite(fi) & np.isfinite(fj)
 
 
+@njit(cache=True, parallel=True)
+def aperture_gain_kernel(x, cs, half_coef, ranges, azimuths, out):
+    """Numba kernel of :func:`aperture_gain` (``cs`` = cumulative taper sums with a leading 0)."""
+    n = x.size
+    rail = x[n - 1] - x[0]
+    for i in prange(ranges.size):
+        half = half_coef * ranges[i]
+        nominal = min(rail, 2.0 * half)
+        for j in range(azimuths.size):
+            a = max(x[0], azimuths[j] - half)
+            b = min(x[n - 1], azimuths[j] + half)
+            if b < a:
+                out[i, j] = 0.0
+                continue
+            s = cs[np.searchsorted(x, b, "right")] - cs[np.searchsorted(x, a, "left")]
+            if s <= 0:
+                out[i, j] = 0.0
+            else:
+                out[i, j] = cs[n] / s * ((b - a) / nominal if nominal > 0 else 1.0)
+
+
 def aperture_gain(prof: RangeProfiles, antenna_length_m: float, ranges: np.ndarray, azimuths: np.ndarray,
                   azimuth_window: str = "hamming") -> np.ndarray:
-    """Per-pixel amplitude correction (n_r, n_x) that puts DF on BP's normalization.
+    """Per-pixel amplitude correction (n_r, n_x) float32 that puts DF on BP's normalization.
 
     DF divides by the taper sum over the whole rail, but a scatterer at (x, R0) is seen only from its
     synthetic aperture ``[a, b]`` = rail ∩ beam footprint ``|x_i - x| <= lam R0/(2 L_x)``; BP divides by
@@ -163,9 +184,18 @@ def aperture_gain(prof: RangeProfiles, antenna_length_m: float, ranges: np.ndarr
     The gain ``sum_rail w / sum_[a,b] w * (b - a)/min(X, lam R0/L_x)`` is 1 in region II and makes the
     stitched ``auto`` image continuous where DF takes over in region I; 0 where no stop sees the pixel.
     """
+    cs = np.concatenate([[0.0], np.cumsum(stop_weights(prof, azimuth_window))])
+    out = np.empty((np.size(ranges), np.size(azimuths)), np.float32)
+    aperture_gain_kernel(prof.positions_m, cs, prof.wavelength_m / (2 * antenna_length_m),
+                         np.ascontiguousarray(ranges, np.float64), np.ascontiguousarray(azimuths, np.float64), out)
+    return out
+
+
+def aperture_gain_reference(prof: RangeProfiles, antenna_length_m: float, ranges: np.ndarray,
+                            azimuths: np.ndarray, azimuth_window: str = "hamming") -> np.ndarray:
+    """Plain-numpy reference of :func:`aperture_gain`."""
     x = prof.positions_m
-    w = stop_weights(prof, azimuth_window)
-    cs = np.concatenate([[0.0], np.cumsum(w)])
+    cs = np.concatenate([[0.0], np.cumsum(stop_weights(prof, azimuth_window))])
     half = prof.wavelength_m / (2 * antenna_length_m) * np.asarray(ranges, np.float64)[:, None]
     px = np.asarray(azimuths, np.float64)[None, :]
     a, b = np.maximum(x[0], px - half), np.minimum(x[-1], px + half)

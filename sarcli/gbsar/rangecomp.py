@@ -93,12 +93,13 @@ def range_compress(scan: Scan, pol: str, window_name: str = "hamming", oversampl
     r_top = C_LIGHT / (4 * df) if max_range_m is None else min(float(max_range_m), C_LIGHT / (4 * df))
     n_keep = min(int(np.floor(r_top / dr + 1e-9)) + 1, n_fft // 2 + 1)
     w = window(window_name, n_r)
-    x = np.where(bad[:, None], 0.0, s) * (w / w.sum())[None, :]
-    p = scipy.fft.ifft(x.astype(np.complex128), n=n_fft, axis=1)[:, :n_keep] * n_fft
+    x = s.astype(np.complex64) * (w / w.sum()).astype(np.float32)[None, :]  # complex64: the data's precision
+    x[bad] = 0.0
+    p = scipy.fft.ifft(x, n=n_fft, axis=1)[:, :n_keep]
     kc = (n_r - 1) / 2
-    p *= np.exp(-2j * np.pi * kc * np.arange(n_keep) / n_fft)[None, :]
+    p *= (n_fft * np.exp(-2j * np.pi * kc * np.arange(n_keep) / n_fft)).astype(np.complex64)[None, :]
     fc = 0.5 * (scan.frequency[0] + scan.frequency[-1])
-    return RangeProfiles(data=p.astype(np.complex64), dr_m=dr, center_frequency_hz=float(fc),
+    return RangeProfiles(data=np.ascontiguousarray(p), dr_m=dr, center_frequency_hz=float(fc),
                          frequency_step_hz=df, n_freq=n_r, positions_m=np.asarray(scan.rail_position, np.float64),
                          heights_m=np.asarray(scan.rail_height, np.float64), weights=(~bad).astype(np.float64),
                          skipped=[int(i) for i in np.flatnonzero(bad)])

@@ -325,3 +325,18 @@ def test_bp_polar_grid_matches_df_native_grid_far_away():
         assert abs(20 * np.log10(sub_d[ib, jb] / sub_b[ib, jb])) < 0.5
         dphi = np.angle(dfi_r0[i - 2 + ib, j - 2 + jb] * np.conj(bp[i - 2 + ib, j - 2 + jb]))
         assert abs(dphi) < 0.2
+
+
+def test_aperture_gain_kernel_matches_reference_and_theory():
+    from sarcli.gbsar.deramp import aperture_gain, aperture_gain_reference
+
+    s = scan_of([(0.0, 5.0)], rail=4.0)
+    prof = range_compress(s, "VV")
+    ranges, az = np.array([0.0, 2.0, 5.0, 30.0]), np.linspace(-6.0, 6.0, 25)
+    g = aperture_gain(prof, 0.25, ranges, az)
+    np.testing.assert_allclose(g, aperture_gain_reference(prof, 0.25, ranges, az), rtol=1e-6)
+    assert g[3, 12] == pytest.approx(1.0)  # region II at the centre: the whole rail
+    w = np.hamming(81)
+    half = LAM * 5.0 / (2 * 0.25)
+    inside = np.abs(prof.positions_m) <= half
+    assert g[2, 12] == pytest.approx(w.sum() / w[inside].sum(), rel=1e-6)  # region I: rail sum / footprint sum
