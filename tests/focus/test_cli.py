@@ -83,3 +83,14 @@ def test_focus_refuses_bad_input_in_one_line(cli, tmp_path):
     assert r.exit_code != 0 and "interpolator" in r.stderr
     r = cli("quality", tmp_path / "missing.h5")
     assert r.exit_code != 0 and r.stderr.startswith("sarcli: error:")
+    # a product without an Earth orbit cannot be geocoded: refused before any work
+    from sarcli.io.raw import write_raw
+
+    from .synth import scene
+
+    write_raw(tmp_path / "flat.h5", scene([], n_lines=64, n_samples=600))
+    r = cli("focus", tmp_path / "flat.h5", "-o", tmp_path / "slc.h5", "--fdc", "0", "--fr", "-2000",
+            "--geotiff", tmp_path / "a.tif")
+    assert r.exit_code != 0 and "Earth orbit" in r.stderr and not (tmp_path / "slc.h5").exists()
+    r = cli("focus", tmp_path / "flat.h5", "-o", tmp_path / "slc.h5", "--fdc", "0", "--fr", "2000")
+    assert r.exit_code != 0 and "negative" in r.stderr

@@ -110,6 +110,9 @@ def focus(
     in_memory = (doppler is None and fdc is None) or algorithm != "rd"
     raw = read_raw(raw_path, load_echo=in_memory)
     shape = raw.shape if in_memory else raw_shape(raw_path)
+    if (geotiff or geotiff_slant) and (raw.orbit is None or raw.orbit.frame == "LOCAL"):
+        raise SarcliError(f"{raw_path}: GeoTIFF needs an Earth orbit (ECI/ECEF state vectors); this product has "
+                          f"{'none' if raw.orbit is None else 'a LOCAL (flat) frame'}: drop --geotiff/--geotiff-slant")
     if not 0 <= channel < raw.n_channels:
         raise SarcliError(f"{raw_path}: product has {raw.n_channels} channel(s), channel {channel} requested")
     t0 = time.perf_counter()
