@@ -36,6 +36,8 @@ def test_samples_parse():
     (orbit_scene_text(effects=("range_migration", "sparkle")), "unknown effect 'sparkle'; known effects: antenna"),
     (orbit_scene_text(effects=("noise",)), "noise needs a table [noise]"),
     (orbit_scene_text(effects=("second_channel",)), "second_channel needs a table"),
+    (orbit_scene_text(extra="[range_migration]\nstrength = 2\n"), "[range_migration] unknown key(s): strength"),
+    (orbit_scene_text(extra="[bogus]\nx = 1\n"), "top level: unknown key(s): bogus"),
     (linear_scene_text(effects=("earth_rotation",)), "earth_rotation needs an orbit"),
     (orbit_scene_text().replace("n_lines = 512", "n_lines = -3"), "[radar] n_lines: expected an integer >= 1"),
     (orbit_scene_text().replace("prf_hz", "prf_hzz"), "[radar] prf_hz: required number is missing"),

@@ -33,6 +33,18 @@ def registry() -> dict[str, ModuleType]:
     return out
 
 
+def no_parameters(table: Any, platform: Any) -> None:
+    """``parse`` of an effect without parameters (its table, if any, must be empty)."""
+    return None
+
+
+def switch(attribute: str):
+    """``configure`` of an effect that only switches one physics flag of the SimContext on."""
+    def configure(ctx: Any, params: Any) -> None:
+        setattr(ctx, attribute, True)
+    return configure
+
+
 def known_effects() -> list[str]:
     return sorted(registry())
 

@@ -5,13 +5,10 @@ along-track and elevation planes (``sarcli.sim.pointing``). Without it the proce
 (|sin psi_az| <= beam_extent * lam / L) is uniformly illuminated and every range is lit equally.
 """
 
+from sarcli.sim.effects import no_parameters, switch
+
 NAME = "antenna_pattern"
 DOC = "sinc^2 two-way azimuth and elevation amplitude gain (else uniform inside the beam)"
 
-
-def parse(table, platform):
-    return None
-
-
-def configure(ctx, params):
-    ctx.antenna_pattern = True
+parse = no_parameters
+configure = switch("antenna_pattern")

@@ -6,13 +6,13 @@ its reference time, the same waveform the echo kernel uses. Quantized too if qua
 
 import numpy as np
 
+from sarcli.sim.effects import no_parameters
+
 NAME = "chirp_replica"
 DOC = "store the chirp replica in the product"
 ORDER = 10
 
-
-def parse(table, platform):
-    return None
+parse = no_parameters
 
 
 def replica(radar) -> np.ndarray:

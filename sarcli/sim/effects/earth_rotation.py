@@ -5,6 +5,7 @@ rotation, p_eci(t) = Rz(theta(t))^T p_ecef with theta the GMST angle (orbit.fram
 """
 
 from sarcli.errors import FormatError
+from sarcli.sim.effects import switch
 
 NAME = "earth_rotation"
 DOC = "targets fixed to the rotating Earth (else inertial)"
@@ -18,5 +19,4 @@ def parse(table, platform):
     return None
 
 
-def configure(ctx, params):
-    ctx.earth_rotation = True
+configure = switch("earth_rotation")

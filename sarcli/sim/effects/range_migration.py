@@ -5,13 +5,10 @@ cell migration); the carrier phase exp(-j*4*pi*R(t)/lam) always follows the exac
 there would be no synthetic aperture to simulate.
 """
 
+from sarcli.sim.effects import no_parameters, switch
+
 NAME = "range_migration"
 DOC = "echo envelope follows the exact hyperbolic range (else frozen at closest approach)"
 
-
-def parse(table, platform):
-    return None
-
-
-def configure(ctx, params):
-    ctx.range_migration = True
+parse = no_parameters
+configure = switch("range_migration")

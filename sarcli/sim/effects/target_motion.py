@@ -6,13 +6,10 @@ target's reference time (its azimuth_time_s for slant-placed targets, else the s
 Without this effect the velocities in the file are ignored (static scene).
 """
 
+from sarcli.sim.effects import no_parameters, switch
+
 NAME = "target_motion"
 DOC = "targets move with their given velocity (else static)"
 
-
-def parse(table, platform):
-    return None
-
-
-def configure(ctx, params):
-    ctx.target_motion = True
+parse = no_parameters
+configure = switch("target_motion")
