@@ -68,7 +68,7 @@ def _data_for(raw: RawProduct, estimator: str) -> tuple[np.ndarray, int]:
 def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 128, estimator: str = "cde",
                      ambiguity: str = "auto", ambiguity_value: int | None = None, fr_method: str = "auto",
                      fdc_model: str = "vector", fit_degree: tuple[int, int] = (2, 1),
-                     resid_degree: tuple[int, int] = (1, 1), model_degree: tuple[int, int] = (3, 2),
+                     resid_degree: tuple[int, int] = (0, 0), model_degree: tuple[int, int] = (4, 2),
                      n_nodes: int | None = None, exact_attitude: bool = True, height_m: float | None = None,
                      half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
                      min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
@@ -188,9 +188,12 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     step("ambiguity")
 
     # 4. 2-D fit with outlier flags. With an orbit the geometric model gives the SHAPE of the centroid
-    # over the scene (exact to < 0.001 Hz) and the data its offset: the blocks fit a low-order residual
-    # (data - model; a slope only with >= 8 distinct block coordinates on that axis: the residual is
-    # mostly the attitude-knowledge offset), and the model + residual is sampled on a dense grid and
+    # over the scene (exact to < 0.001 Hz) and the data its offset: the blocks fit a residual (data -
+    # model), by default a constant: it is the attitude-knowledge offset, whose variation across a
+    # swath is a few per cent of itself, while a fitted slope follows scene content (bright targets)
+    # and is extrapolated by the focuser to zero-Doppler ranges outside the swath; with
+    # resid_degree > 0 a slope needs >= 8 distinct block coordinates on its axis. The model + residual
+    # is sampled on a dense grid and
     # fitted by a higher-order polynomial (noise-free, fit error reported). Without an orbit the blocks
     # are fitted directly.
     GR, GT = _model_grid(raw)
@@ -276,10 +279,17 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
 
 
 def _model_grid(raw: RawProduct, n_r: int = 24, n_t: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    """Dense (time, range) grid over the whole scene on which the smooth models are sampled."""
+    """Dense (time, range) grid on which the smooth orbit-based models are sampled: the scene, extended
+    in range by 2 % of the range (+-20 km at 1000 km: a focuser evaluates the model at zero-Doppler
+    ranges R0 = Rc cos(squint), below the raw swath) and in time by 1 s, within the orbit span."""
     r = raw.slant_range()
     t = raw.azimuth_time
-    T, R = np.meshgrid(np.linspace(t[0], t[-1], n_t), np.linspace(r[0], r[-1], n_r), indexing="ij")
+    pad_r = 0.02 * r[-1]
+    t_lo, t_hi = t[0] - 1.0, t[-1] + 1.0
+    if raw.orbit is not None:
+        t_lo, t_hi = max(t_lo, float(raw.orbit.time[0])), min(t_hi, float(raw.orbit.time[-1]))
+    T, R = np.meshgrid(np.linspace(t_lo, t_hi, n_t), np.linspace(r[0] - pad_r, r[-1] + pad_r, n_r),
+                       indexing="ij")
     return R, T
 
 

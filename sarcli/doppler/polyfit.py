@@ -1,7 +1,9 @@
 """Weighted 2-D polynomial fit z(x, y) = sum_{i<=dx, j<=dy} c_ij x^i y^j with outlier flags.
 
 x, y are normalized coordinates (``Poly2D`` stores the offsets and scales, so evaluation takes physical
-range in m and azimuth time in s). Outliers: after a weighted least-squares fit, blocks whose residual
+range in m and azimuth time in s). Outside the fitted domain the polynomial is held constant at the
+domain edge (coordinates are clipped): a cubic extrapolated a few swath widths away swings by hundreds
+of Hz, a clipped one cannot. Outliers: after a weighted least-squares fit, blocks whose residual
 exceeds ``k_sigma`` robust standard deviations (1.4826 * weighted MAD, floored at ``floor``) are
 flagged and the fit is repeated without them, until no new block is flagged. Flagged blocks are kept in
 the tables (with their flag), never silently used.
@@ -24,7 +26,8 @@ def poly2d_design(x: np.ndarray, y: np.ndarray, degree: tuple[int, int]) -> np.n
 
 @dataclass
 class Poly2D:
-    """z = sum c[i, j] u^i v^j with u = (x - x0)/xs, v = (y - y0)/ys. Units of z as fitted."""
+    """z = sum c[i, j] u^i v^j with u = (x - x0)/xs, v = (y - y0)/ys, |u|, |v| clipped to 1 (the fitted
+    domain is x0 +- xs, y0 +- ys). Units of z as fitted."""
 
     coef: np.ndarray  # (dx+1, dy+1)
     x0: float
@@ -33,8 +36,8 @@ class Poly2D:
     ys: float
 
     def __call__(self, x, y) -> np.ndarray:
-        u = (np.asarray(x, float) - self.x0) / self.xs
-        v = (np.asarray(y, float) - self.y0) / self.ys
+        u = np.clip((np.asarray(x, float) - self.x0) / self.xs, -1.0, 1.0)
+        v = np.clip((np.asarray(y, float) - self.y0) / self.ys, -1.0, 1.0)
         u, v = np.broadcast_arrays(u, v)
         out = np.zeros(u.shape)
         for i in range(self.coef.shape[0]):

@@ -95,4 +95,6 @@ def test_poly2d_degrades_degree_with_one_range_block():
     y = np.array([0.0, 1.0, 2.0])
     p, flags = fit_poly2d(x, y, np.array([1.0, 2.0, 3.0]), np.ones(3), degree=(2, 1))
     assert p.coef.shape == (1, 2) and not flags.any()
-    assert p(850e3, 3.0) == pytest.approx(4.0)
+    assert p(850e3, 1.5) == pytest.approx(2.5)
+    assert p(850e3, 3.0) == pytest.approx(3.0)  # held at the domain edge, not extrapolated
+    assert p(900e3, -7.0) == pytest.approx(1.0)
