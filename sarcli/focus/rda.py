@@ -262,8 +262,14 @@ def _src_rcmc_rows(y, factor, inv_k, f_bin, p, fs, v, fdc, dt, ph0, wtab, kind, 
     f_tau = sfft.fftfreq(n2, 1.0 / fs)
     w = wtab * factor
     dr = C / (2.0 * fs)
-    for c in range(0, na, rows):
-        d = min(na, c + rows)
+    # rows whose frequency lies outside the processed band at every range are zero: skip their FFTs
+    off = f_bin[:, None] - fdc[None, ::16]
+    off -= p.prf * np.floor(off / p.prf + 0.5)
+    active = np.any(np.abs(off) <= 0.5 * p.ba * (1.0 + 1e-9), axis=1)
+    y[~active] = 0.0
+    edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
+    chunks = [(c, min(b, c + rows)) for a, b in zip(edges[::2], edges[1::2], strict=True) for c in range(a, b, rows)]
+    for c, d in chunks:
         t0 = time.perf_counter()
         zz = np.zeros((d - c, n2), y.dtype)
         zz[:, :nr] = y[c:d]
