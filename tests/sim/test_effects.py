@@ -42,7 +42,7 @@ def test_inertial_zero_attitude_has_zero_doppler(orbit_scene):
     L = beam_vector(r, v, raw.truth["beam_look_angle_rad"], pitch, raw.attitude.yaw)
     assert np.max(np.abs(np.einsum("ij,ij->i", L, v))) < 1e-6 * 7500
     L0 = beam_vector(r, v, raw.truth["beam_look_angle_rad"], 0.0, 0.0)
-    assert np.min(np.abs(2 / raw.radar.wavelength_m * np.einsum("ij,ij->i", L0, v))) > 20.0  # Hz
+    assert np.min(np.abs(2 / raw.radar.wavelength_m * np.einsum("ij,ij->i", L0, v))) > 300.0  # Hz (-470 Hz here)
 
 
 def test_earth_rotation_doppler_matches_independent_geometry(orbit_scene):
