@@ -301,8 +301,8 @@ def _central_lines(echo: np.ndarray, max_lines: int) -> np.ndarray:
 
 
 def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int, max_lines: int):
-    """Map-drift rate per range segment over the central ``max_lines`` lines; linear fit in range of
-    the segments that converged to within 30 % of their start value (constant in time)."""
+    """Map-drift rate per range segment over the central ``max_lines`` lines; fr*R fitted linearly in
+    range over the segments that converged to within 30 % of their start value (constant in time)."""
     from sarcli.doppler.mapdrift import map_drift
     from sarcli.doppler.rangecomp import range_compress_valid
 
@@ -333,6 +333,10 @@ def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_s
     if not frs:
         raise SarcliError("map-drift did not converge in any range segment (no focusable scene content?); "
                           "give the Doppler rate another way (--fr-method orbit needs state vectors)")
-    rr = np.array(rng)
-    poly, _ = fit_poly2d(rr, np.full(rr.size, t_c), np.array(frs), np.ones(rr.size), (1, 0), k_sigma=np.inf)
+    # fr = -2 V^2/(lam R): fit fr*R (~ -2 V^2/lam) linearly in R over the segments, then sample it over
+    # the model grid (whole swath + margin), so the polynomial's domain covers the swath
+    rr, ff = np.array(rng), np.array(frs)
+    k = np.polyfit(rr, ff * rr, 1 if rr.size > 1 else 0)
+    GR, GT = _model_grid(raw)
+    poly, _ = fit_poly2d(GR, GT, np.polyval(k, GR) / GR, np.ones_like(GR), (3, 0), k_sigma=np.inf)
     return poly, poly(Rg, T), info
