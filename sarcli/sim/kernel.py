@@ -9,11 +9,12 @@ travels; times relative to the scene centre):
     s[c, k, n] += a_i G_ik exp(-j 4 pi R_c / lam) exp(+j pi K tau^2),  tau = ws + n/fs - 2 R_env/c,
                   for the samples with |tau| <= T/2 only (pulse centred on its delay)
     G_ik    = sinc^2(L_az sin(psi_az)/lam) sinc^2(L_el sin(psi_el)/lam) with antenna_pattern, else 1,
-              sin(psi_az) = d.x_k/|d|, sin(psi_el) = d.e_k/|d|
+              sin(psi_az) = d.x_k/|d|, sin(psi_el) = d.e_k/|d|; G = 0 outside the elevation main lobe
+              |sin(psi_el)| > emax = beam_extent lam/L_el (so the far side of the track stays dark)
 
-Only the pulses with |sin(psi_az)| <= smax (the processed beam, found by bisection since
-sin(psi_az) decreases monotonically as the target passes) and only the samples inside the pulse
-are computed. Cost model: sum over targets of (pulses in beam) x (T fs samples) x (channels),
+Only the pulses with |sin(psi_az)| <= smax = beam_extent lam/L_az (the processed beam, found by
+bisection since sin(psi_az) decreases monotonically as the target passes) and only the samples
+inside the pulse are computed. Cost model: sum over targets of (pulses in beam) x (T fs samples) x (channels),
 about 2 complex multiplies and one add per sample (the chirp phasor is advanced by recurrence:
 z_{n+1} = z_n w_n, w_{n+1} = w_n exp(j 2 pi K dt^2), exact in exact arithmetic, drift ~1e-12 in
 float64 over a pulse; two interleaved chains, see ``_add_chirp``), plus O(log n_lines) per target
@@ -86,17 +87,20 @@ def _sinc2(x):
 
 
 @njit(cache=True, inline="always")
-def _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, p):
-    """(d, R_tx, gain) of target i seen from pulse k; d = p_k - r_k returned in p."""
+def _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, emax, p):
+    """(R_tx, gain) of target i seen from pulse k, d = p_k - r_k returned in p; gain 0 outside the
+    elevation main lobe |sin(psi_el)| > emax (e.g. the other side of the track)."""
     _target_at(rot, k, tp, tv, i, t[k] - tref[i], p)
     p[0] -= rp[k, 0]
     p[1] -= rp[k, 1]
     p[2] -= rp[k, 2]
     rtx = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    se = (p[0] * ue[k, 0] + p[1] * ue[k, 1] + p[2] * ue[k, 2]) / rtx
+    if abs(se) > emax:
+        return rtx, 0.0
     g = 1.0
     if pattern:
         sa = (p[0] * ux[k, 0] + p[1] * ux[k, 1] + p[2] * ux[k, 2]) / rtx
-        se = (p[0] * ue[k, 0] + p[1] * ue[k, 1] + p[2] * ue[k, 2]) / rtx
         g = _sinc2(laz * sa) * _sinc2(lel * se)
     return rtx, g
 
@@ -148,7 +152,7 @@ def _add_chirp(row, n_lo, n_hi, z, w, ww):  # pragma: no cover - compiled
 
 @njit(cache=True, parallel=True)
 def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
-                migrate, pattern, laz, lel, block, line0, line1):  # pragma: no cover - compiled
+                migrate, pattern, laz, lel, emax, block, line0, line1):  # pragma: no cover - compiled
     """Accumulate every target's echo into lines [line0, line1) of out (n_channels, n_lines, n_samples)."""
     n_ch, n_lines, n_s = out.shape
     n_t = tp.shape[0]
@@ -163,7 +167,9 @@ def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, 
         d = np.empty(3)
         for i in range(n_t):
             for k in range(max(k0[i], a0), min(k1[i], a1)):
-                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, d)
+                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, emax, d)
+                if g == 0.0:
+                    continue
                 for c in range(n_ch):
                     rc = _channel_range(d, rtx, rx_off[c], ux, k)
                     td = 2.0 * (rc if migrate else r0[i]) / C
@@ -180,7 +186,7 @@ def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, 
 
 @njit(cache=True, parallel=True)
 def splat_kernel(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
-                 migrate, pattern, laz, lel, block):  # pragma: no cover - compiled
+                 migrate, pattern, laz, lel, emax, block):  # pragma: no cover - compiled
     """Binned clutter: add a_i G exp(-j 4 pi R_c/lam) at fractional delay bin x = 2 R_env/c * fq - x0 of
     grid (n_channels, lines line0.., >= n_l), split linearly between the two neighbouring bins < n_l."""
     n_ch, n_lines, _ = grid.shape
@@ -192,7 +198,9 @@ def splat_kernel(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1
         d = np.empty(3)
         for i in range(n_t):
             for k in range(max(k0[i], a0), min(k1[i], a1)):
-                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, d)
+                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, emax, d)
+                if g == 0.0:
+                    continue
                 for c in range(n_ch):
                     rc = _channel_range(d, rtx, rx_off[c], ux, k)
                     x = 2.0 * (rc if migrate else r0[i]) / C * fq - x0
@@ -205,8 +213,15 @@ def splat_kernel(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1
                     grid[c, k - line0, j + 1] += z * f
 
 
+def _gain_reference(d, rtx, ux, ue, pattern, laz, lel, emax):
+    """Numpy twin of the gain of :func:`_geometry` for a vector of pulses."""
+    se = np.einsum("ki,ki->k", d, ue) / rtx
+    g = np.sinc(laz * np.einsum("ki,ki->k", d, ux) / rtx) ** 2 * np.sinc(lel * se) ** 2 if pattern else 1.0
+    return np.where(np.abs(se) > emax, 0.0, g)
+
+
 def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
-                   migrate, pattern, laz, lel):
+                   migrate, pattern, laz, lel, emax):
     """Plain-numpy reference of :func:`echo_kernel` (same arguments, no block): vectorized per target."""
     n_ch, n_lines, n_s = out.shape
     for i in range(tp.shape[0]):
@@ -217,11 +232,7 @@ def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_of
         p = np.einsum("kij,kj->ki", rot[ks], q)
         d = p - rp[ks]
         rtx = np.linalg.norm(d, axis=1)
-        g = np.ones_like(rtx)
-        if pattern:
-            sa = np.einsum("ki,ki->k", d, ux[ks]) / rtx
-            se = np.einsum("ki,ki->k", d, ue[ks]) / rtx
-            g = np.sinc(laz * sa) ** 2 * np.sinc(lel * se) ** 2
+        g = _gain_reference(d, rtx, ux[ks], ue[ks], pattern, laz, lel, emax)
         for c in range(n_ch):
             rc = rtx if rx_off[c] == 0 else 0.5 * (rtx + np.linalg.norm(d - rx_off[c] * ux[ks], axis=1))
             renv = rc if migrate else np.full_like(rc, r0[i])
@@ -238,7 +249,7 @@ def echo_reference(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_of
 
 
 def splat_reference(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
-                    migrate, pattern, laz, lel):
+                    migrate, pattern, laz, lel, emax):
     """Plain-numpy reference of :func:`splat_kernel` (same arguments, no block)."""
     n_ch, n_lines, _ = grid.shape
     for i in range(tp.shape[0]):
@@ -248,10 +259,7 @@ def splat_reference(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0,
         q = tp[i] + tv[i] * (t[ks] - tref[i])[:, None]
         d = np.einsum("kij,kj->ki", rot[ks], q) - rp[ks]
         rtx = np.linalg.norm(d, axis=1)
-        g = np.ones_like(rtx)
-        if pattern:
-            g = (np.sinc(laz * np.einsum("ki,ki->k", d, ux[ks]) / rtx) ** 2
-                 * np.sinc(lel * np.einsum("ki,ki->k", d, ue[ks]) / rtx) ** 2)
+        g = _gain_reference(d, rtx, ux[ks], ue[ks], pattern, laz, lel, emax)
         for c in range(n_ch):
             rc = rtx if rx_off[c] == 0 else 0.5 * (rtx + np.linalg.norm(d - rx_off[c] * ux[ks], axis=1))
             x = 2.0 * (rc if migrate else np.full_like(rc, r0[i])) / C * fq - x0

@@ -137,8 +137,9 @@ class RadarConfig:
 class AntennaConfig:
     """Antenna: azimuth length, elevation height, boresight look angle from the nadir, beam extent.
 
-    ``beam_extent`` is the processed half-width of the azimuth beam in units of the first null
-    (|sin psi_az| <= beam_extent * lam / length_m); pulses outside it are not computed.
+    ``beam_extent`` is the processed half-width of the beam in units of the first null: pulses with
+    |sin psi_az| > beam_extent * lam / length_m are not computed, and targets with
+    |sin psi_el| > beam_extent * lam / height_m (e.g. on the other side of the track) stay dark.
     """
 
     length_m: float

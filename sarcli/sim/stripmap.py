@@ -70,7 +70,8 @@ def kernel_args(scene: Scene, ctx: SimContext, traj: Trajectory, motion: Motion,
     return (t, traj.position, np.ascontiguousarray(ux), np.ascontiguousarray(ue), rot, q, u, tref,
             ts.amp.astype(np.complex128), k0, k1, r0, np.array(ctx.receiver_offsets_m, np.float64), lam,
             rad.chirp_rate_hz_per_s, rad.pulse_length_s, rad.range_sampling_rate_hz, rad.window_start_s,
-            ctx.range_migration, ctx.antenna_pattern, ant.length_m / lam, ant.height_m / lam)
+            ctx.range_migration, ctx.antenna_pattern, ant.length_m / lam, ant.height_m / lam,
+            ant.beam_extent * lam / ant.height_m)
 
 
 def simulate(scene: Scene, dtype=np.complex64, progress: Callable[[int], None] | None = None) -> RawProduct:

@@ -76,3 +76,20 @@ def test_airborne_moving_target_two_channels_match_truth(linear_scene):
         exp, mask = _expected(sc, R, R, amp=2.0)
         assert _max_phase_error(ch, exp, mask) < 1e-6
     assert raw.radar.receiver_offsets_m == (0.0, d)
+
+
+def test_left_looking_airborne_target(linear_scene):
+    tgt = "[[targets]]\nx_m = -5095.3\ny_m = 0.0\n"
+    text_scene = linear_scene(effects=("range_migration", "antenna_pattern"), targets=tgt)
+    sc = type(text_scene.radar)(**{**text_scene.radar.__dict__, "look_side": "left"})
+    text_scene.radar = sc
+    raw = simulate(text_scene, dtype=np.complex128)
+    assert raw.look_side == "left" and np.abs(raw.echo).max() > 0.5
+    t = raw.azimuth_time
+    R = np.linalg.norm(np.stack([-5095.3 + 0 * t, -2000.0 * t, -10000.0 + 0 * t], 1), axis=1)
+    exp, mask = _expected(text_scene, R, R)
+    sel = mask & (np.abs(raw.echo) > 0)
+    assert np.max(np.abs(np.angle(raw.echo[sel] * np.conj(exp[sel])))) < 1e-6
+    # a right-looking radar does not see a target on its left
+    right = simulate(linear_scene(effects=("range_migration",), targets=tgt))
+    assert np.abs(right.echo).max() == 0
