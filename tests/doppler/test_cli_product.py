@@ -77,3 +77,22 @@ def test_read_doppler_refuses_other_products(tmp_path, raw_file):
 
     with pytest.raises(ProductError, match="expected doppler"):
         read_doppler(raw_file)
+
+
+def test_cli_on_the_real_vancouver_block(cli, shared_data, tmp_path):
+    """Real RADARSAT-1 echoes, no orbit: data-only ambiguity -6 (published centroid ~ -7050 Hz), an
+    honest confidence, and a map-drift rate consistent with the published Vr = 7062 m/s (+-1 %)."""
+    raw = tmp_path / "van.h5"
+    r = cli("ingest", "--matlab", shared_data / "rs1_vancouver_block1.mat",
+            "--params", shared_data / "rs1_vancouver_run_params.mat", "-o", raw)
+    assert r.exit_code == 0, r.stderr
+    r = cli("doppler", raw, "--az-block", "1536", "--json")
+    assert r.exit_code == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["fdc_baseband_hz"] == pytest.approx(487.0, abs=5.0)
+    assert d["ambiguity"] == -6 and d["ambiguity_source"] == "data"
+    assert 0.3 < d["ambiguity_confidence"] < 0.9  # MLBF and MLCC disagree: not a certainty
+    assert d["fr_method"] == "mapdrift"
+    lam = 2.9979e8 / 5.3e9
+    fr_pub = -2 * 7062.0**2 / (lam * d["scene_range_m"])
+    assert d["fr_hz_per_s"] == pytest.approx(fr_pub, rel=0.01)
