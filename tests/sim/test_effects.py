@@ -193,3 +193,19 @@ def test_sea_land_clutter_centroid_matches_truth(orbit_scene):
     truth = raw.truth["doppler_centroid_hz"]
     for sl in (slice(40, 200), slice(200, 360)):
         assert abs(wrap(cde(e[:, sl], prf) - np.nanmean(truth[sl]), prf)) < 0.005 * prf
+
+
+def test_quantization_present_only_when_listed(orbit_scene):
+    extra = "[noise]\nsnr_db = 10.0\n[quantization]\nbits = 4\n"
+    off = simulate(orbit_scene(effects=("range_migration", "noise"), extra=extra))
+    on = simulate(orbit_scene(effects=("range_migration", "noise", "quantization", "chirp_replica"), extra=extra))
+    assert off.agc_db is None and off.radar.quantization_bits == 0
+    assert np.any(off.echo.real != np.round(off.echo.real))
+    assert on.radar.quantization_bits == 4 and on.agc_db.shape == (on.echo.shape[0],)
+    levels = np.unique(np.concatenate([on.echo.real.ravel(), on.echo.imag.ravel(), on.replica.real]))
+    assert set(levels.tolist()) <= set(range(-15, 16, 2))
+    # AGC undone, the quantized echo correlates with the float one as a 4-bit quantizer should (> 0.98)
+    x = off.echo.astype(np.complex128)
+    y = on.echo.astype(np.complex128) * 10 ** (on.agc_db[:, None] / 20)
+    rho = np.abs(np.vdot(x, y)) / np.sqrt(np.vdot(x, x).real * np.vdot(y, y).real)
+    assert rho > 0.98
