@@ -75,7 +75,7 @@ def test_indoor_rd_and_bp_focus_target_and_wall(indoor_images):
             i, j, a = peak_near(img, g.ranges, g.azimuths, 5.0, x)
             assert abs(g.azimuths[j] - x) <= dx + 1e-9 and abs(g.ranges[i] - 5.0) <= dr, (alg, x)
             amps.append(a)
-        assert 20 * np.log10(min(amps) / max(amps)) > -1.0, alg  # uniform focusing across the beam
+        assert 20 * np.log10(min(amps) / max(amps)) > -0.3, alg  # uniform across the beam (README: 0.1 dB)
         wall_row = int(np.argmin(abs(g.ranges - 6.0)))
         rows = np.argmax(np.abs(img[wall_row - 2:wall_row + 3, np.abs(g.azimuths) <= 1.5]), axis=0) + wall_row - 2
         assert np.all(np.abs(g.ranges[rows] - 6.0) <= dr), alg  # the wall is a line at 6 m
@@ -178,7 +178,7 @@ def test_azimuth_resolution_by_region(r0, xc, region):
     opts = FocusOptions(algorithm="bp", azimuth_window="none", range_window="none")
     grid = Grid(ranges=np.array([r0]), azimuths=xc + np.linspace(-4 * res, 4 * res, 801))
     row = focus_scan(s, opts, grid=grid).image[0, 0]
-    assert width_at(row, grid.azimuths, 2 / np.pi) == pytest.approx(res, rel=0.10)
+    assert width_at(row, grid.azimuths, 2 / np.pi) == pytest.approx(res, rel=0.03)  # README: within 1.5 %
 
 
 @pytest.mark.parametrize("r0, xc", [(5.0, 0.0), (60.0, 0.0), (10.0, 1.5)])

@@ -128,8 +128,10 @@ def test_ps_coherence_stable_vs_decorrelated():
 
 
 def test_temporal_coherence_theory():
-    z = np.exp(1j * np.array([0.0, 0.1, -0.1, 0.05]))[:, None]
-    assert temporal_coherence(z)[0] == pytest.approx(abs(np.exp(1j * np.array([0, 0.1, -0.1, 0.05])).sum()) / 4)
+    """gamma = |sum z| / sum |z| (seed 003): unequal amplitudes tell it apart from |sum z| / N."""
+    amp, ph = np.array([1.0, 3.0, 0.5, 2.0]), np.array([0.0, 0.1, -0.1, 0.05])
+    z = (amp * np.exp(1j * ph))[:, None]
+    assert temporal_coherence(z)[0] == pytest.approx(abs(np.sum(amp * np.exp(1j * ph))) / amp.sum())
     with pytest.raises(SarcliError):
         temporal_coherence(z[:1])
 

@@ -73,8 +73,10 @@ def test_region_formulas_match_eq_27_33_39_45():
     assert reg == "IV" and d == pytest.approx(1 / (2 / (lam * 10) * (x / 2 - 2.0) + 1 / lx))
     reg, d = azimuth_resolution(100.0, 5.0, x, lam, lx, "df")
     assert d == pytest.approx(lam * np.hypot(100, 5) / (2 * x))
-    # seed 003: 0.5 m at 100 m and 3.4 m at 600 m
-    assert azimuth_resolution(100.0, 0.0, x, lam, lx)[1] == pytest.approx(0.57, abs=0.02)
+    # seed 003 quotes 0.5 m at 100 m and 3.4 m at 600 m. Its own formula lam R/(2X) gives 0.566 m at
+    # 100 m (lam = 0.0566 m, X = 5 m): the printed 0.5 m is rounded down, not reproduced; 3.4 m is.
+    assert azimuth_resolution(100.0, 0.0, x, lam, lx)[1] == pytest.approx(lam * 100.0 / (2 * x), rel=1e-9)
+    assert azimuth_resolution(100.0, 0.0, x, lam, lx)[1] == pytest.approx(0.566, abs=0.002)
     assert azimuth_resolution(600.0, 0.0, x, lam, lx)[1] == pytest.approx(3.4, abs=0.02)
 
 
