@@ -42,15 +42,10 @@ class Trajectory:
 
     def state(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(r, v, a) at times t (s relative to the scene centre), any shape -> (..., 3)."""
-        t = np.asarray(t, np.float64)
         if self._linear is not None:
-            lp = self._linear
-            r = np.stack(np.broadcast_arrays(lp.x_m, lp.y_m + lp.velocity_mps * t, lp.height_m), -1)
-            v = np.zeros_like(r)
-            v[..., 1] = lp.velocity_mps
-            return r, v, np.zeros_like(r)
+            return linear_state(self._linear, t)
         assert self._sv is not None
-        return self._sv.interpolate(t)
+        return self._sv.interpolate(np.asarray(t, np.float64))
 
     @property
     def span(self) -> tuple[float, float]:
@@ -58,6 +53,15 @@ class Trajectory:
         if self._sv is None:
             return (-np.inf, np.inf)
         return self._sv.span
+
+
+def linear_state(lp: LinearPlatform, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Straight flight: r = (x_m, y_m + V t, H), v = (0, V, 0), a = 0 (LOCAL frame)."""
+    t = np.asarray(t, np.float64)
+    r = np.stack(np.broadcast_arrays(lp.x_m, lp.y_m + lp.velocity_mps * t, lp.height_m), -1)
+    v = np.zeros_like(r)
+    v[..., 1] = lp.velocity_mps
+    return r, v, np.zeros_like(r)
 
 
 def pulse_times(scene: Scene) -> np.ndarray:
@@ -72,10 +76,8 @@ def build_trajectory(scene: Scene) -> Trajectory:
     p = scene.platform
     tc = scene.center_time_s
     if isinstance(p, LinearPlatform):
-        traj = Trajectory("LOCAL", t, np.empty((0, 3)), np.empty((0, 3)), None, None, p)  # type: ignore[arg-type]
-        traj.position, traj.velocity, _ = traj.state(t)
-        traj.product_orbit = Orbit(tc + t[[0, -1]], traj.position[[0, -1]], traj.velocity[[0, -1]], "LOCAL")
-        return traj
+        r, v, _ = linear_state(p, t)
+        return Trajectory("LOCAL", t, r, v, Orbit(tc + t[[0, -1]], r[[0, -1]], v[[0, -1]], "LOCAL"), None, p)
     if isinstance(p, OrbitPlatform):
         from orbit.propagate import kepler_to_state, propagate_j2
 
