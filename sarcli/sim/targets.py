@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from orbit.geodetic import geodetic_to_ecef
+from sarcli.errors import FormatError
 from sarcli.sim.geometry import Motion, enu_basis, snap_to_height, surface_point
 from sarcli.sim.pointing import antenna_axes
 
@@ -37,9 +38,9 @@ class TargetSet:
 def _axes_at(ctx, traj, t: float):
     r, v, _ = traj.state(np.array([t]))
     a = ctx.scene.antenna
-    ux, ue, ub, _ = antenna_axes(r, v, traj.frame, a.look_angle_rad, ctx.pitch_rad, ctx.yaw_rad,
-                                 ctx.scene.radar.look_side)
-    return r[0], ux[0], ub[0]
+    ux, _, _, _ = antenna_axes(r, v, traj.frame, a.look_angle_rad, ctx.pitch_rad, ctx.yaw_rad,
+                               ctx.scene.radar.look_side)
+    return r[0], ux[0]
 
 
 def place(ctx, traj, motion: Motion, where: tuple) -> tuple[np.ndarray, float, np.ndarray]:
@@ -55,16 +56,13 @@ def place(ctx, traj, motion: Motion, where: tuple) -> tuple[np.ndarray, float, n
         t_ref = 0.0
     else:
         rho, t_ref, h = where[1], where[2], where[3]
-        r, ux, _ = _axes_at(ctx, traj, t_ref)
+        r, ux = _axes_at(ctx, traj, t_ref)
         p = surface_point(r, ux, np.array([rho]), h, ctx.scene.radar.look_side, traj.frame)[0]
         if not np.all(np.isfinite(p)):
-            from sarcli.errors import FormatError
-
             raise FormatError(f"{ctx.scene.path}: slant range {rho:.1f} m at azimuth time {t_ref:g} s "
                               "does not reach the ground (shorter than the altitude or beyond the horizon)")
         q = motion.to_target_frame(p, np.array(t_ref))
-    _, ux, _ = _axes_at(ctx, traj, t_ref)
-    along = motion.to_target_frame(ux, np.array(t_ref))
+    along = motion.to_target_frame(_axes_at(ctx, traj, t_ref)[1], np.array(t_ref))
     return q, float(t_ref), along
 
 
