@@ -182,7 +182,7 @@ def focus(
             "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, d.velocity_mps.shape[1] // 2])),
         },
         "image_statistics": stats,
-        "timings_s": {"doppler": t_doppler, **slc.timings, "geotiff_quicklook": t_products,
+        "timings_s": {"doppler": t_doppler, **slc.timings, "statistics_and_products": t_products,
                       "total": time.perf_counter() - t_start},
         "peak_rss_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
         "warnings": [str(w.message) for w in caught],
