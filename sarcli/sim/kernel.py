@@ -150,16 +150,43 @@ def _add_chirp(row, n_lo, n_hi, z, w, ww):  # pragma: no cover - compiled
         row[n] += ze
 
 
-@njit(cache=True, parallel=True)
-def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
-                migrate, pattern, laz, lel, emax, block, line0, line1):  # pragma: no cover - compiled
-    """Accumulate every target's echo into lines [line0, line1) of out (n_channels, n_lines, n_samples)."""
-    n_ch, n_lines, n_s = out.shape
-    n_t = tp.shape[0]
-    line1 = min(line1, n_lines)
-    n_blocks = (line1 - line0 + block - 1) // block
+@njit(cache=True, inline="always")
+def _pulse(row, renv, z, kr, plen, fs, ws, ww):
+    """Add the chirp of a target at envelope range renv (carrier/gain already in z) to one echo line."""
+    n_s = row.shape[0]
     dts = 1.0 / fs
-    ww_arg = 2.0 * math.pi * kr * dts * dts
+    td = 2.0 * renv / C
+    n_lo = max(0, math.ceil((td - 0.5 * plen - ws) * fs))
+    n_hi = min(n_s - 1, math.floor((td + 0.5 * plen - ws) * fs))
+    if n_hi < n_lo:
+        return
+    tau = ws + n_lo * dts - td
+    a = math.pi * kr * tau * tau
+    wa = math.pi * kr * (2.0 * tau * dts + dts * dts)
+    _add_chirp(row, n_lo, n_hi, z * complex(math.cos(a), math.sin(a)), complex(math.cos(wa), math.sin(wa)), ww)
+
+
+@njit(cache=True, inline="always")
+def _splat(row, renv, z, fq, x0, n_l):
+    """Split z linearly between the two grid bins around x = 2 renv/c fq - x0 (bins < n_l only)."""
+    x = 2.0 * renv / C * fq - x0
+    j = math.floor(x)
+    if j < 0 or j + 1 >= n_l:
+        return
+    f = x - j
+    row[j] += z * (1.0 - f)
+    row[j + 1] += z * f
+
+
+@njit(cache=True, parallel=True)
+def _traverse(out, row0, splat, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, migrate, pattern,
+              laz, lel, emax, kr, plen, fs, ws, fq, x0, n_l, block, line0, line1):  # pragma: no cover - compiled
+    """Every (target, pulse in its beam, channel) of lines [line0, line1): chirp into out[c, k - row0]
+    (echo) or splat into it (binned clutter grid). Parallel over blocks of lines (no write races)."""
+    n_ch = out.shape[0]
+    n_t = tp.shape[0]
+    n_blocks = (line1 - line0 + block - 1) // block
+    ww_arg = 2.0 * math.pi * kr / (fs * fs)
     ww = complex(math.cos(ww_arg), math.sin(ww_arg))
     for b in prange(n_blocks):
         a0 = line0 + b * block
@@ -172,45 +199,29 @@ def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, 
                     continue
                 for c in range(n_ch):
                     rc = _channel_range(d, rtx, rx_off[c], ux, k)
-                    td = 2.0 * (rc if migrate else r0[i]) / C
-                    n_lo = max(0, math.ceil((td - 0.5 * plen - ws) * fs))
-                    n_hi = min(n_s - 1, math.floor((td + 0.5 * plen - ws) * fs))
-                    if n_hi < n_lo:
-                        continue
-                    tau = ws + n_lo * dts - td
-                    a = math.pi * kr * tau * tau
-                    z = amp[i] * g * _carrier(rc, lam) * complex(math.cos(a), math.sin(a))
-                    wa = math.pi * kr * (2.0 * tau * dts + dts * dts)
-                    _add_chirp(out[c, k], n_lo, n_hi, z, complex(math.cos(wa), math.sin(wa)), ww)
+                    renv = rc if migrate else r0[i]
+                    z = amp[i] * g * _carrier(rc, lam)
+                    if splat:
+                        _splat(out[c, k - row0], renv, z, fq, x0, n_l)
+                    else:
+                        _pulse(out[c, k - row0], renv, z, kr, plen, fs, ws, ww)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
+def echo_kernel(out, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, kr, plen, fs, ws,
+                migrate, pattern, laz, lel, emax, block, line0, line1):  # pragma: no cover - compiled
+    """Accumulate every target's echo into lines [line0, line1) of out (n_channels, n_lines, n_samples)."""
+    _traverse(out, 0, False, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, migrate, pattern,
+              laz, lel, emax, kr, plen, fs, ws, 0.0, 0.0, 0, block, line0, min(line1, out.shape[1]))
+
+
+@njit(cache=True)
 def splat_kernel(grid, line0, n_l, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, fq, x0,
                  migrate, pattern, laz, lel, emax, block):  # pragma: no cover - compiled
     """Binned clutter: add a_i G exp(-j 4 pi R_c/lam) at fractional delay bin x = 2 R_env/c * fq - x0 of
     grid (n_channels, lines line0.., >= n_l), split linearly between the two neighbouring bins < n_l."""
-    n_ch, n_lines, _ = grid.shape
-    n_t = tp.shape[0]
-    n_blocks = (n_lines + block - 1) // block
-    for b in prange(n_blocks):
-        a0 = line0 + b * block
-        a1 = min(line0 + n_lines, a0 + block)
-        d = np.empty(3)
-        for i in range(n_t):
-            for k in range(max(k0[i], a0), min(k1[i], a1)):
-                rtx, g = _geometry(t, rp, ux, ue, rot, tp, tv, tref, i, k, pattern, laz, lel, emax, d)
-                if g == 0.0:
-                    continue
-                for c in range(n_ch):
-                    rc = _channel_range(d, rtx, rx_off[c], ux, k)
-                    x = 2.0 * (rc if migrate else r0[i]) / C * fq - x0
-                    j = math.floor(x)
-                    if j < 0 or j + 1 >= n_l:
-                        continue
-                    f = x - j
-                    z = amp[i] * g * _carrier(rc, lam)
-                    grid[c, k - line0, j] += z * (1.0 - f)
-                    grid[c, k - line0, j + 1] += z * f
+    _traverse(grid, line0, True, t, rp, ux, ue, rot, tp, tv, tref, amp, k0, k1, r0, rx_off, lam, migrate, pattern,
+              laz, lel, emax, 0.0, 0.0, 1.0, 0.0, fq, x0, n_l, block, line0, line0 + grid.shape[1])
 
 
 def _gain_reference(d, rtx, ux, ue, pattern, laz, lel, emax):
