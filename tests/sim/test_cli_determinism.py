@@ -70,3 +70,13 @@ def test_ceos_export_refuses_unquantized_scene(cli, tmp_path):
     last = r.stderr.strip().splitlines()[-1]
     assert r.exit_code != 0 and last.startswith("sarcli: error:") and "quantiz" in last
     assert "Traceback" not in r.stderr
+
+
+def test_cli_seed_override(cli, tmp_path):
+    scene = tmp_path / "s.toml"
+    scene.write_text(orbit_scene_text(effects=("range_migration", "noise"), extra=NOISE, n_lines=64, seed=3))
+    for name, extra in (("a.h5", ()), ("b.h5", ("--seed", "3")), ("c.h5", ("--seed", "4"))):
+        assert cli("simulate", scene, "-o", tmp_path / name, *extra).exit_code == 0
+    a, b, c = (read_raw(tmp_path / n) for n in ("a.h5", "b.h5", "c.h5"))
+    assert np.array_equal(a.echo, b.echo) and not np.array_equal(a.echo, c.echo)
+    assert int(c.truth["seed"]) == 4

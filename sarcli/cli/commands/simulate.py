@@ -15,6 +15,7 @@ def simulate(
     output: Path = typer.Option(..., "-o", "--output", help="Raw product (HDF5) or, with --format ceos, a folder."),
     fmt: str = typer.Option("hdf5", "--format", help="hdf5 (raw product) or ceos (Radarsat-1 leader + data)."),
     compression: str = typer.Option(None, "--compression", help="HDF5 compression of the echo (gzip, lzf)."),
+    seed: int = typer.Option(None, "--seed", min=0, help="Override the scene's seed (Monte-Carlo runs)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
     """Simulate the raw echoes of a stripmap scene; only the effects the scene lists are computed.
@@ -31,6 +32,8 @@ def simulate(
       sarcli simulate samples/rs1_point.toml --format ceos -o demo/ceos
 
       sarcli simulate samples/airborne_ati.toml -o ati.h5 --json
+
+      sarcli simulate samples/airborne_ati.toml -o ati_run7.h5 --seed 7
     """
     import time
 
@@ -43,6 +46,8 @@ def simulate(
     if compression not in (None, "gzip", "lzf"):
         raise SarcliError(f"--compression must be gzip or lzf, got {compression!r}")
     sc = load_scene(scene)
+    if seed is not None:
+        sc.seed = seed
     effects = ", ".join(sc.effects) or "none"
     info(f"simulating {sc.name}: {sc.radar.n_lines} x {sc.radar.n_samples} samples, {len(sc.targets)} target(s), "
          f"{len(sc.clutter)} clutter patch(es), effects: {effects}")
