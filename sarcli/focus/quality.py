@@ -59,9 +59,10 @@ def cut_metrics(cut: np.ndarray, step: float, extent: float = 20.0) -> CutMetric
     irw = (crossing(1) - crossing(-1)) * step
 
     def first_min(direction: int) -> int:
-        # start beyond the half-power point: a noise dip on a wide main lobe is not its first minimum
+        # start where the main lobe is 10 dB down (every usual window's lobe passes -10 dB before its
+        # first null): a noise ripple on the flank of a wide, noisy main lobe is not its first minimum
         i = i0
-        while 0 <= i + direction < p.size and p[i] > half:
+        while 0 <= i + direction < p.size and p[i] > 0.1 * pk:
             i += direction
         while 0 <= i + direction < p.size and p[i + direction] <= p[i]:
             i += direction

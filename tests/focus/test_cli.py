@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from .theory import irf_theory
+
 SCENES = Path(__file__).parent / "scenes"
 
 
@@ -59,6 +61,7 @@ def test_simulate_focus_geocode_quality(cli, tmp_path):
         # rect range window: IRW 0.886 c / (2B), PSLR -13.26 dB (B = 0.72135e12 x 41.74e-6)
         assert m["irw_range_m"] == pytest.approx(0.886 * c / (2 * 0.72135e12 * 41.74e-6), rel=0.05)
         assert abs(m["pslr_range_db"] + 13.26) < 0.3
+        assert abs(m["islr_range_db"] - irf_theory("rect")["islr_db"]) < 0.3
         assert m["position_error_m"] < 0.1 * dr
 
     with rasterio.open(tmp_path / "amp.tif") as ds:
