@@ -92,6 +92,9 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
             raise SarcliError(f"unknown {name} {val!r}; choose one of {', '.join(allowed)}")
     if az_block < 2 or rg_block < 1:
         raise SarcliError(f"block size must be at least 2 lines x 1 sample, got {az_block} x {rg_block}")
+    # the AGC changes line by line as bright targets cross the beam: left in, it re-weights the azimuth
+    # spectrum asymmetrically (20 Hz on samples/rs1_point.toml)
+    raw = raw.calibrated()
     radar = raw.radar
     prf, lam = radar.prf_hz, radar.wavelength_m
     n_lines, n_samples = raw.echo.shape

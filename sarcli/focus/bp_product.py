@@ -41,7 +41,8 @@ def focus_bp(raw: RawProduct, doppler, channel: int = 0, lines: tuple[int, int] 
     ref = reference_pulse(radar, raw.replica if k.use_replica else None)
     h, _ = range_filter(radar, sfft.next_fast_len(nr + ref.size - 1), k.range_window,
                         raw.replica if k.use_replica else None, k.range_bandwidth_fraction)
-    data = echo if raw.agc_db is None else echo * (10.0 ** (raw.agc_db / 20.0)).astype(np.float32)[:, None]
+    gain = raw.line_gain()
+    data = echo if gain is None else echo * gain[:, None]
     rc = compress_lines(data, h.astype(np.complex128), nr, k.workers)
     t_rc = time.perf_counter() - t_start
     tt, rr = np.meshgrid(t_out[la:lb], p.ranges[sa:sb], indexing="ij")

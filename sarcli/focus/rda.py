@@ -319,7 +319,7 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
     table = table.astype(np.float32 if k.precision == "single" else np.float64)  # single: complex64 taps
     f_bin = sfft.fftfreq(p.n_fft_az, 1.0 / p.prf)
     dr = C / (2.0 * radar.range_sampling_rate_hz)
-    gain = None if raw.agc_db is None else (10.0 ** (np.asarray(raw.agc_db, np.float64) / 20.0)).astype(np.float32)
+    gain = raw.line_gain()
     t_raw = raw.azimuth_time
     dt = 1.0 / p.prf
     msgs = _coverage_warnings(doppler, p.ranges, t_raw)

@@ -130,6 +130,20 @@ class RawProduct:
         n = self.echo.shape[1]
         return self.radar.first_range_m + np.arange(n) * c / (2.0 * self.radar.range_sampling_rate_hz)
 
+    def line_gain(self) -> np.ndarray | None:
+        """float32 factor per line that undoes the receiver attenuation, 10**(agc_db/20); None without AGC."""
+        if self.agc_db is None:
+            return None
+        return (10.0 ** (np.asarray(self.agc_db, np.float64) / 20.0)).astype(np.float32)
+
+    def calibrated(self) -> RawProduct:
+        """The same product with the per-line AGC undone in the echo (a copy; itself when there is no AGC)."""
+        gain = self.line_gain()
+        if gain is None:
+            return self
+        extra = None if self.echo_channels is None else self.echo_channels * gain[None, :, None]
+        return dataclasses.replace(self, echo=self.echo * gain[:, None], echo_channels=extra, agc_db=None)
+
     def channel(self, k: int) -> np.ndarray:
         """Echo of receive channel k (0 = /echo)."""
         if k == 0:

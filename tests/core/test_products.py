@@ -179,3 +179,12 @@ def test_extra_root_attributes_round_trip(tmp_path):
     p.extra_attrs = {"ceos_beam": "F1", "published_fdc_hz": -6900.0}
     write_raw(tmp_path / "r.h5", p)
     assert read_raw(tmp_path / "r.h5").extra_attrs == {"ceos_beam": "F1", "published_fdc_hz": -6900.0}
+
+
+def test_calibrated_undoes_agc_per_line():
+    p = _raw(n_lines=4)
+    p.agc_db = np.array([0.0, 6.0, 20.0, 3.0], np.float32)
+    q = p.calibrated()
+    np.testing.assert_allclose(q.echo[2], p.echo[2] * 10.0, rtol=1e-6)
+    np.testing.assert_allclose(q.echo[1], p.echo[1] * 10 ** (6 / 20), rtol=1e-6)
+    assert q.agc_db is None and p.agc_db is not None  # the original is untouched
