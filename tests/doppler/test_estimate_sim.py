@@ -178,7 +178,7 @@ def test_very_short_scene_and_saturated_4bit():
     text = scene_text(extra_effects=("quantization",), extra="\n[quantization]\nbits = 4\ntarget_rms = 40.0\n")
     raw = simulate_text(text)
     assert np.mean(np.abs(raw.echo.real) == 15) > 0.3  # saturated
-    short = dataclasses.replace(raw, echo=raw.echo[:200], azimuth_time=raw.azimuth_time[:200])
+    short = dataclasses.replace(raw, echo=raw.echo[:200], azimuth_time=raw.azimuth_time[:200], agc_db=raw.agc_db[:200])
     m = estimate_doppler(short)
     assert m.summary["n_az_blocks"] == 1
     tf, _, rho = _truth(raw)
