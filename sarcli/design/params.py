@@ -132,10 +132,10 @@ def from_toml(path: str | Path) -> DesignParams:
     unknown = sorted(set(d) - known)
     if unknown:
         raise SarcliError(f"{path}: unknown design key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-    try:
-        p = DesignParams(processor=proc, source=path.name, **d)
-    except TypeError as e:
-        raise SarcliError(f"{path}: {e}") from None
+    for required in ("platform", "carrier_frequency_hz"):
+        if required not in d:
+            raise SarcliError(f"{path}: [design] {required} is required")
+    p = DesignParams(processor=proc, source=path.name, **d)
     return validate(p, str(path))
 
 

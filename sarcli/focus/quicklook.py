@@ -25,5 +25,6 @@ def write_slc_quicklook(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ma
     t = slc.azimuth_time
     r = slc.slant_range / 1e3
     extent = (r[0], r[min(m, inten.shape[1] * lr) - 1], t[min(n, inten.shape[0] * la) - 1], t[0])
-    write_quicklook(path, np.sqrt(inten), title=title or f"SLC amplitude ({la} x {lr} looks)", dynamic_range_db=40.0,
+    looks = f"{la} x {lr} looks" + (f": {looks_az} x {looks_rg} asked, x{f} to fit {max_pixels} px" if f > 1 else "")
+    write_quicklook(path, np.sqrt(inten), title=title or f"SLC amplitude ({looks})", dynamic_range_db=40.0,
                     extent=extent, xlabel="slant range (km)", ylabel="zero-Doppler time (s)")

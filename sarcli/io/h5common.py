@@ -19,7 +19,6 @@ import hashlib
 import json
 import os
 import sys
-import tempfile
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ import numpy as np
 
 from sarcli import __version__
 from sarcli.errors import ProductError
+from sarcli.io.atomic import atomic_path
 
 PROVENANCE_ATTRS = (
     "product_type",
@@ -109,13 +109,7 @@ def atomic_h5(
     Yields an ``h5py.File``. Use :func:`dataset` to create datasets so that they are
     reproducible (no timestamps) and carry units.
     """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ProductError(f"output folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
-    try:
+    with atomic_path(path, ".tmp") as tmp:
         with h5py.File(tmp, "w", libver=("earliest", "v110"), track_order=False) as f:
             f.attrs["product_type"] = product_type
             f.attrs["schema_version"] = schema_version
@@ -125,18 +119,6 @@ def atomic_h5(
             f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; a product gets the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _command_line() -> str:

@@ -5,34 +5,14 @@ GeoTIFFs are written atomically (temporary file in the target folder, then renam
 
 from __future__ import annotations
 
-import contextlib
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from sarcli.errors import ProductError
-
-
-@contextlib.contextmanager
-def atomic_path(path: str | os.PathLike, suffix: str):
-    """Yield a temporary file name in ``path``'s folder; it is renamed to ``path`` only on success."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ProductError(f"output folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=folder)
-    os.close(fd)
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+from sarcli.io.atomic import atomic_path  # re-exported: plots and CSV writers import it from here
 
 
 def write_geotiff(
@@ -120,7 +100,10 @@ def write_quicklook(
     if np.iscomplexobj(image) or not is_db and cmap == "gray":
         data = amplitude_db(image)
         finite = data[np.isfinite(data)]
-        top = float(np.percentile(finite, 99.9)) if finite.size else 0.0
+        # white at the 99.9th percentile (scenes), but never more than 20 dB under the peak: on a point
+        # scene the percentile sits in the sidelobes/quantization floor and would paint it as white as
+        # the targets
+        top = max(float(np.percentile(finite, 99.9)), float(finite.max()) - 20.0) if finite.size else 0.0
         vmax = top if vmax is None else vmax
         vmin = vmax - dynamic_range_db if vmin is None else vmin
         colorbar_label = colorbar_label or "amplitude (dB)"

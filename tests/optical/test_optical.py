@@ -197,3 +197,10 @@ def test_cli_focus_algorithm_optical(cli, tmp_path):
     assert abs(slc.slant_range[j] - R0) < 3.0
     # within a tenth of the CCD-limited azimuth cell (4.27 m = 67 lines; the 8-bit read-out is noisy)
     assert abs(slc.azimuth_time[k] - slc.truth["targets"]["zero_doppler_time_s"][0]) * 250.0 < 0.43
+
+
+@pytest.mark.parametrize("opt", ["0", "-5"])
+def test_cli_refuses_a_non_positive_reference_offset_before_any_work(cli, tmp_path, opt):
+    r = cli("optical", "compare", tmp_path / "missing.h5", "--reference-offset-hz", opt)
+    assert r.exit_code == 2 and r.stderr.strip().splitlines() == [
+        f"sarcli: error: reference offset must be a positive frequency (Hz), got {float(opt)}"]

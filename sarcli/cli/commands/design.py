@@ -63,8 +63,7 @@ def _format(r: dict) -> str:
         lines += [f"  slant range (centre)       {r['slant_range_m']:.1f} m, "
                   f"incidence {r['incidence_angle_deg']:.2f} deg",
                   f"  swath (slant)              {r['swath_slant_m']:.1f} m",
-                  f"  PRF window                 {r['prf_min_hz']:.1f} Hz < PRF < {r['prf_max_hz']:.1f} Hz"
-                  + ("  (upper bound: one pulse in flight)" if r["platform"] == "spaceborne" else ""),
+                  _prf_window_line(r),
                   "  PRF options:"]
         for o in r["prf_options"]:
             broken = ", ".join(c["name"] for c in o["constraints"] if not c["ok"])
@@ -74,6 +73,16 @@ def _format(r: dict) -> str:
     lines += [f"  note: {n}" for n in r["notes"]]
     lines.append("  verdict: " + ("all constraints met" if r["ok"] else "; ".join(r["violations"])))
     return "\n".join(lines)
+
+
+def _prf_window_line(r: dict) -> str:
+    lo = f"  PRF window                 {r['prf_min_hz']:.1f} Hz < PRF"
+    lo_why = ("2v/D" if any("2v/D" in c["relation"] for o in r["prf_options"] for c in o["constraints"])
+              else "processed Doppler bandwidth v / delta_az: no antenna length given")
+    if r["platform"] == "spaceborne":
+        return (f"{lo}  ({lo_why}); upper bound: the echo-window timing per PRF below (the one-pulse-in-flight "
+                f"bound c/(2 R_max) = {r['prf_max_hz']:.1f} Hz does not apply in orbit)")
+    return f"{lo} < {r['prf_max_hz']:.1f} Hz  (lower: {lo_why}; upper: c/(2 R_max))"
 
 
 def register(app: typer.Typer) -> None:

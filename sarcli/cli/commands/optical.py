@@ -39,9 +39,9 @@ def compare_cmd(
     from sarcli.optical.devices import CCD, OpticalSettings
     from sarcli.optical.plot import comparison_png
 
-    raw = read_raw(raw_path)
     settings = OpticalSettings(ccd=CCD(adc_bits=adc_bits), reference_offset_hz=reference_offset_hz,
-                               magnification=magnification)
+                               magnification=magnification)  # checked before reading anything
+    raw = read_raw(raw_path)
     with progress_bar(len(cases(not quick)) + 1, label="images", disable=json_out) as bar:
         report = compare(raw, settings, centre_range_m=centre_range_m, single_limitations=not quick,
                          keep_images=plot is not None, on_step=lambda _label: bar.update(1))
