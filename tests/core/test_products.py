@@ -188,3 +188,16 @@ def test_calibrated_undoes_agc_per_line():
     np.testing.assert_allclose(q.echo[2], p.echo[2] * 10.0, rtol=1e-6)
     np.testing.assert_allclose(q.echo[1], p.echo[1] * 10 ** (6 / 20), rtol=1e-6)
     assert q.agc_db is None and p.agc_db is not None  # the original is untouched
+
+
+def test_images_get_the_usual_file_mode_too(tmp_path):
+    import os
+    import stat
+
+    from sarcli.io.images import write_quicklook
+
+    write_quicklook(tmp_path / "q.png", np.ones((8, 8), np.complex64))
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE((tmp_path / "q.png").stat().st_mode) == 0o666 & ~mask
+    assert [p.name for p in tmp_path.iterdir()] == ["q.png"]  # no temporary left behind
