@@ -140,11 +140,17 @@ def slow_time(pair: Pair, c: Candidate, bin_mode: str = "track") -> tuple[SlowTi
     rows, cols = _window(pair, c)
     s0 = decompress(pair.slc0, pair.z0, rows, cols)
     s1 = decompress(pair.slc0, pair.z1, rows, cols)
-    # range bin from the clutter-cancelled (DPCA) signal: stationary scatterers in the window also
-    # have a constant slow-time amplitude (small ANV), but cancel in s1 - s0*exp(j*phi_c)
+    # Range bin: the seed's minimum ANV, computed on the clutter-cancelled (DPCA) signal (stationary
+    # scatterers in the window also have a constant slow-time amplitude but cancel in
+    # s1 - s0*exp(j*phi_c)), among the bins within +-3 of the detected peak (at low SNR the DPCA
+    # signal, ~phi_ATI^2 weaker than s0, is noise-dominated away from the mover).
     ranges = np.asarray(pair.slc0.slant_range)[cols]
     phi_c = bistatic_phase(ranges, pair.baseline_m, pair.platform.wavelength)
-    n0 = choose_bin(s1 - s0 * np.exp(1j * phi_c)[None, :])
+    pk = c.peak_col - cols.start
+    lo, hi = max(0, pk - 3), min(len(ranges), pk + 4)
+    n0 = lo + choose_bin((s1 - s0 * np.exp(1j * phi_c)[None, :])[:, lo:hi])
+    if bin_mode == "track":
+        n0 = pk         # tracking starts from the detected peak and follows the mover's drift
     pick = track_peak if bin_mode == "track" else single_bin
     a0, pos = pick(s0, n0)
     a1, _ = pick(s1, n0)
@@ -154,7 +160,8 @@ def slow_time(pair: Pair, c: Candidate, bin_mode: str = "track") -> tuple[SlowTi
     shift = int(pair.slc0.parameters.get("shift_lines", 0))
     eta = eta + shift / float(pair.slc0.parameters.get("prf_hz", pair.slc0.prf_hz))
     # 1-sigma of the mean tracked range: quantization bound dr/sqrt(12) (conservative)
-    obs = SlowTime(eta, a0, a1, r_track, dr / math.sqrt(12.0), pair.platform, pair.baseline_m, pair.look_sign)
+    obs = SlowTime(eta, a0, a1, r_track, dr / math.sqrt(12.0), pair.platform, pair.baseline_m, pair.look_sign,
+                   noise_dof=rows.stop - rows.start)
     return obs, rows, cols, s0
 
 

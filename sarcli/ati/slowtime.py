@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.fft as sfft
+from scipy import ndimage
 
 from sarcli.errors import SarcliError
 from sarcli.focus.kinematics import migration_factor
@@ -111,15 +112,17 @@ def choose_bin(slow: np.ndarray, min_power_fraction: float = 0.1) -> int:
     return int(np.argmin(v))
 
 
-def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """Per row, the sample of largest magnitude within ``col +- halfwidth`` (range tracking), and its
-    fractional column (parabolic interpolation of the magnitude).
+def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4, smooth: int = 63) -> tuple[np.ndarray, np.ndarray]:
+    """Range tracking: per row, the sample nearest a smooth track of the magnitude peak within
+    ``col +- halfwidth``, and that track (fractional column).
 
     A mover's range history differs from the stationary one the RCMC assumes, so it drifts by a
     few range bins over a long aperture (R'^2*R*(1/V^2 - 1/Vp^2)/2, ~2.4 m at the start of the
     paper's CPI); a single bin (the seed's ANV choice) then loses it and picks up the phase of
     the compressed pulse's sidelobes. Within the mainlobe the phase of the compressed pulse is
-    flat, so the per-row peak carries the mover's phase.
+    flat, so the sample at the track carries the mover's phase. The per-row peaks (parabolic
+    interpolation of the magnitude) are median-filtered over ``smooth`` rows so that noise peaks
+    at low SNR do not make the track jump to noise bins.
     """
     a, b = max(0, col - halfwidth), min(slow.shape[1], col + halfwidth + 1)
     blk = slow[:, a:b]
@@ -131,7 +134,9 @@ def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4) -> tuple[np.ndarr
     den = y0 - 2.0 * y1 + y2
     with np.errstate(divide="ignore", invalid="ignore"):
         off = np.where((den < 0) & (km != k) & (kp != k), 0.5 * (y0 - y2) / den, 0.0)
-    return blk[rows, k], a + k + off
+    track = ndimage.median_filter(k + off, size=min(smooth, 2 * (blk.shape[0] // 2) - 1 or 1), mode="nearest")
+    kk = np.clip(np.rint(track).astype(int), 0, blk.shape[1] - 1)
+    return blk[rows, kk], a + track
 
 
 def single_bin(slow: np.ndarray, col: int) -> tuple[np.ndarray, np.ndarray]:
