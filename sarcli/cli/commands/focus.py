@@ -96,6 +96,7 @@ def focus(
     from sarcli.io.slc import SLC, slc_writer, write_slc
 
     t_start = time.perf_counter()
+    _check_output_options(looks_az, looks_rg, crs, spacing, azimuth_bandwidth, range_band_fraction)
     knobs = {"range_window": range_window, "azimuth_window": azimuth_window,
              "azimuth_bandwidth_hz": azimuth_bandwidth, "range_bandwidth_fraction": range_band_fraction,
              "rcmc": rcmc, "src": src, "precision": "double" if double else "single", "block_lines": block_lines,
@@ -182,8 +183,7 @@ def focus(
             "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, d.velocity_mps.shape[1] // 2])),
         },
         "image_statistics": stats,
-        "timings_s": {"doppler": t_doppler, **slc.timings, "statistics_and_products": t_products,
-                      "total": time.perf_counter() - t_start},
+        "timings_s": _timings(t_doppler, slc.timings, t_products, time.perf_counter() - t_start),
         "peak_rss_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
         "warnings": [str(w.message) for w in caught],
         "parameters": slc.parameters,
@@ -193,11 +193,46 @@ def focus(
     else:
         du = report["doppler_used"]
         info(f"focused {raw_path.name} -> {output} ({shape[0]} x {shape[1]}, {algorithm}) in "
-             f"{report['timings_s']['total']:.2f} s; Doppler {how}: fdc {du['fdc_hz_mid']:.1f} Hz, "
+             f"{report['timings_s']['total_s']:.2f} s; Doppler {how}: fdc {du['fdc_hz_mid']:.1f} Hz, "
              f"fr {du['fr_hz_per_s_mid']:.2f} Hz/s at mid-swath; peak RSS {report['peak_rss_bytes'] / 2**20:.0f} MiB")
         for k, v in products.items():
             if k not in ("slc", "crs"):
                 info(f"wrote {v}")
+
+
+def _check_output_options(looks_az: int, looks_rg: int, crs: str | None, spacing: float | None,
+                          azimuth_bandwidth: float | None, range_band_fraction: float) -> None:
+    """Refuse impossible option values before the Doppler estimate and the focus (one line each)."""
+    import math
+
+    if looks_az < 1 or looks_rg < 1:
+        raise SarcliError(f"--looks-az and --looks-rg must be at least 1, got {looks_az} and {looks_rg}")
+    if spacing is not None and not (math.isfinite(spacing) and spacing > 0):
+        raise SarcliError(f"--pixel-spacing must be a positive number of metres, got {spacing}")
+    if azimuth_bandwidth is not None and not (math.isfinite(azimuth_bandwidth) and azimuth_bandwidth > 0):
+        raise SarcliError(f"--azimuth-bandwidth must be a positive number of Hz, got {azimuth_bandwidth}")
+    if not (math.isfinite(range_band_fraction) and 0 < range_band_fraction <= 1):
+        raise SarcliError(f"--range-band-fraction must be in (0, 1], got {range_band_fraction}")
+    if crs is not None:
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+
+        try:
+            CRS.from_user_input(crs)
+        except CRSError:
+            raise SarcliError(f"--crs {crs!r} is not a known coordinate reference system "
+                              "(e.g. EPSG:32610)") from None
+
+
+def _timings(t_doppler: float, stages: dict, t_products: float, t_total: float) -> dict:
+    """Seconds per stage, every key ending in ``_s``: the focuser's own total becomes ``focus_s``
+    and ``total_s`` is the whole command (reading, Doppler, focus, statistics and products)."""
+    out = {"doppler_s": t_doppler}
+    for k, v in stages.items():
+        k = k if k.endswith("_s") else f"{k}_s"
+        out["focus_s" if k == "total_s" else k] = v
+    out.update({"statistics_and_products_s": t_products, "total_s": t_total})
+    return out
 
 
 def _parse_sets(items: list[str]) -> dict:

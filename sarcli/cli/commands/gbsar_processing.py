@@ -5,6 +5,7 @@ Heavy modules are imported inside the commands so that this module always import
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,8 @@ import typer
 
 from sarcli.cli.common import emit_json, info, progress
 from sarcli.cli.gbsar_app import attach, gbsar_app
+from sarcli.errors import SarcliError
+from sarcli.gbsar import C_LIGHT
 
 
 @gbsar_app.command("simulate")
@@ -92,6 +95,7 @@ def plan_cmd(
     """
     from sarcli.gbsar.system import azimuth_resolution
 
+    _check_criterion(criterion_deg)
     sysp = _scan_or_scene_system(source, max_range, criterion_deg)
     d = sysp.as_dict()
     top = sysp.r_max_m if sysp.r_max_m < float("inf") else 1000.0
@@ -134,6 +138,37 @@ def plan_cmd(
 
 def _fmt(v) -> str:
     return "n/a" if v is None else f"{v:.4g}"
+
+
+MIN_RANGE_BINS = 4  # an image shallower than this many range bins is a mistake, not a product
+
+
+def _check_criterion(criterion_deg: float) -> None:
+    """The eq. 12 phase-error criterion must lie in (0, 180] degrees."""
+    if not (math.isfinite(criterion_deg) and 0 < criterion_deg <= 180):
+        raise SarcliError(f"--criterion-deg must be in (0, 180] degrees, got {criterion_deg:g}")
+
+
+def _check_range_interval(scan, min_range: float, max_range: float | None) -> None:
+    """Refuse a range interval that holds fewer than MIN_RANGE_BINS range bins, before any focusing.
+
+    The bin is the range-compression sample spacing ``c / (2 N df)``, ``N = 2^ceil(log2 N_f)``
+    (N_Rfft of Table 1); ranges stop at R_max = c / (4 df).
+    """
+    from sarcli.gbsar.rangecomp import check_sweep
+    from sarcli.gbsar.system import next_pow2
+
+    if not (math.isfinite(min_range) and min_range >= 0):
+        raise SarcliError(f"--min-range must be a finite range >= 0 m, got {min_range:g}")
+    if max_range is not None and not (math.isfinite(max_range) and max_range > 0):
+        raise SarcliError(f"--max-range must be a positive range in metres, got {max_range:g}")
+    df = check_sweep(scan.frequency)
+    dr = C_LIGHT / (2 * next_pow2(scan.frequency.size) * df)
+    top = C_LIGHT / (4 * df) if max_range is None else min(max_range, C_LIGHT / (4 * df))
+    if top - min_range < MIN_RANGE_BINS * dr:
+        raise SarcliError(f"the range interval {min_range:g}-{top:g} m holds fewer than {MIN_RANGE_BINS} range bins "
+                          f"of {dr:.3g} m (R_max {C_LIGHT / (4 * df):.4g} m): give --max-range at least "
+                          f"{min_range + MIN_RANGE_BINS * dr:.3g} m and --min-range below it")
 
 
 @gbsar_app.command("focus")
@@ -179,7 +214,9 @@ def focus_cmd(
     from sarcli.io.gbsar_image import write_gbsar_image
     from sarcli.io.scan import read_scan
 
+    _check_criterion(criterion_deg)
     s = read_scan(scan)
+    _check_range_interval(s, min_range, max_range)
     opts = FocusOptions(algorithm=algorithm, range_window=range_window, azimuth_window=azimuth_window,
                         max_range_m=max_range, min_range_m=min_range, pixel_x_m=pixel_x, width_m=width,
                         criterion_rad=math.radians(criterion_deg), near=near, n_xfft=n_xfft,
@@ -277,46 +314,59 @@ def interfere_cmd(
     geotiff: Path = typer.Option(None, "--geotiff", help="UTM GeoTIFF of the residual phase (rad)."),
     png: Path = typer.Option(None, "--png", help="PNG of the residual phase (cyclic colour map)."),
     value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m)."),
+    value_geotiff: Path = typer.Option(None, "--value-geotiff", help="UTM GeoTIFF of the converted value."),
+    min_coherence: float = typer.Option(0.5, "--min-coherence", help="The converted value (product, --value-png, "
+                                        "--value-geotiff) is NaN where the coherence is below this (0 keeps all)."),
     map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
     json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
     """Interferogram of two GB-SAR images: phase, coherence, model phase removed, converted value.
 
     dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m).
-    Scans given instead of images are focused with --algorithm auto first.
+    Scans given instead of images are focused with --algorithm auto first. Pixels outside the beam
+    footprint (no image support) are NaN (blank in PNGs, nodata in GeoTIFFs); the converted value is
+    also NaN where the coherence is below --min-coherence.
 
     Examples:
 
-      sarcli gbsar interfere t2.h5 t3.h5 --mode crosstrack -o xt.h5 --png xt.png --geotiff xt.tif
+      sarcli gbsar interfere t2.h5 t3.h5 --mode crosstrack -o xt.h5 --png xt.png --value-png height.png
 
-      sarcli gbsar interfere t1.h5 t2.h5 --mode dinsar -o dinsar.h5 --json
+      sarcli gbsar interfere t1.h5 t2.h5 --mode dinsar -o dinsar.h5 --value-geotiff los.tif --json
     """
     from sarcli.gbsar.interferometry import interfere
 
     a, b = _load_image(reference), _load_image(secondary)
     pol = (pol or a.polarizations[0]).upper()
-    ifg = interfere(a, b, mode, pol, window, ground_height)
+    ifg = interfere(a, b, mode, pol, window, ground_height, min_coherence)
     attrs = {"mode": mode, "pol": pol, "coherence_window": window, "ground_height_m": ground_height,
+             "min_coherence": min_coherence,
              "rail_height_a_m": a.rail_height_m, "rail_height_b_m": b.rail_height_m,
              "center_frequency_a_hz": a.center_frequency_hz, "center_frequency_b_hz": b.center_frequency_hz,
              "epoch_utc": a.epoch_utc}
     from sarcli.io.interferogram import write_interferogram
 
     write_interferogram(output, ifg, a.range_m, a.azimuth_m, attrs, parameters=attrs, inputs=[reference, secondary])
+    n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
     summary = {"output": str(output), **attrs, "value": ifg.value_name, "unit": ifg.value_unit, "rate": ifg.rate,
-               "mean_coherence": float(np.nanmean(ifg.coherence))}
+               "mean_coherence": float(np.nanmean(ifg.coherence)) if ifg.support.any() else None,
+               "supported_pixels": int(np.count_nonzero(ifg.support)), "valid_value_pixels": n_valid}
     summary.update(_map_outputs(ifg.residual, a, geotiff, png, f"{mode} residual phase ({pol})", "phase (rad)",
                                 "twilight", -np.pi, np.pi, map_pixel))
-    if value_png is not None:
+    if value_png is not None or value_geotiff is not None:
         v = ifg.value[np.isfinite(ifg.value)]
         lo, hi = (np.percentile(v, [2, 98]) if v.size else (0.0, 1.0))
-        _map_outputs(ifg.value, a, None, value_png, f"{mode} {ifg.value_name}", f"{ifg.value_name} ({ifg.value_unit})",
-                     "viridis", float(lo), float(hi), None)
+        title = f"{mode} {ifg.value_name} (coherence >= {min_coherence:g})"
+        summary["value_outputs"] = _map_outputs(ifg.value, a, value_geotiff, value_png, title,
+                                                f"{ifg.value_name} ({ifg.value_unit})", "viridis", float(lo),
+                                                float(hi), map_pixel)
+    if not n_valid:
+        info(f"warning: no pixel has both images' support and coherence >= {min_coherence:g}: the value is all NaN")
     if json_out:
         emit_json(summary)
     else:
-        info(f"wrote {output}: {mode}, mean coherence {summary['mean_coherence']:.3f}, value {ifg.value_name} "
-             f"({ifg.value_unit})")
+        info(f"wrote {output}: {mode}, mean coherence {summary['mean_coherence'] or 0:.3f} over "
+             f"{summary['supported_pixels']} supported pixels, value {ifg.value_name} ({ifg.value_unit}) on "
+             f"{n_valid} with coherence >= {min_coherence:g}")
 
 
 @gbsar_app.command("coherence")
@@ -338,31 +388,34 @@ def coherence_cmd(
       sarcli gbsar coherence p1.h5 p2.h5 p3.h5 p4.h5 --threshold 0.99 -o ps.h5 --csv ps.csv --plot ps.png
     """
     from sarcli.errors import SarcliError
-    from sarcli.gbsar.interferometry import check_compatible
-    from sarcli.gbsar.timeseries import ps_series, select_ps, temporal_coherence
+    from sarcli.gbsar.timeseries import check_series, ps_series, select_ps, temporal_coherence
     from sarcli.io.interferogram import write_ps
 
     if len(images) < 2:
         raise SarcliError("coherence needs at least 2 images")
     imgs = [_load_image(p) for p in images]
     pol = (pol or imgs[0].polarizations[0]).upper()
-    for other in imgs[1:]:
-        check_compatible(imgs[0], other, "dinsar", pol)
+    check_series(imgs, pol, [str(p) for p in images])
     stack = np.stack([im.pol(pol) for im in imgs])
     gamma = temporal_coherence(stack)
     rows, cols = select_ps(gamma, np.mean(np.abs(stack), axis=0), threshold, dynamic_range_db)
     phase, disp = ps_series(stack, rows, cols, imgs[0].wavelength_m)
     t = np.array([_seconds_between(imgs[0].epoch_utc, im.epoch_utc) + im.scan_time_s for im in imgs])
+    by_index = bool(np.any(np.diff(t) <= 0))
+    if by_index:
+        info("warning: the scan times (epoch + mean stop time) are equal or out of order: time_s is kept, "
+             "but the PS plot uses the scan index as its time axis")
     attrs = {"pol": pol, "threshold": threshold, "dynamic_range_db": dynamic_range_db, "epoch_utc": imgs[0].epoch_utc}
     write_ps(output, gamma, t, rows, cols, imgs[0].range_m, imgs[0].azimuth_m, phase, disp, attrs,
              parameters=attrs, inputs=images)
     if csv is not None:
         _write_ps_csv(csv, imgs[0], rows, cols, gamma, phase, disp)
     if plot is not None:
-        _ps_plot(plot, imgs[0], gamma, rows, cols, t, disp)
+        _ps_plot(plot, imgs[0], gamma, rows, cols, np.arange(t.size) if by_index else t / 60.0,
+                 "scan index" if by_index else "time (min)", disp)
     summary = {"output": str(output), "n_images": len(imgs), "n_ps": int(rows.size), "threshold": threshold,
                "max_abs_phase_change_deg": float(np.degrees(np.max(np.abs(phase)))) if rows.size else None,
-               "time_s": t}
+               "time_s": t, "plot_time_axis": "scan_index" if by_index else "time"}
     if json_out:
         emit_json(summary)
     else:
@@ -397,7 +450,7 @@ def _write_ps_csv(path: Path, img, rows, cols, gamma, phase, disp) -> None:
                        + [f"{v:.3f}" for v in np.degrees(phase[k])] + [f"{v:.4f}" for v in disp[k]])
 
 
-def _ps_plot(path: Path, img, gamma, rows, cols, t, disp) -> None:
+def _ps_plot(path: Path, img, gamma, rows, cols, t_axis, t_label: str, disp) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -410,8 +463,8 @@ def _ps_plot(path: Path, img, gamma, rows, cols, t, disp) -> None:
     a1.set(xlabel="azimuth x (m)", ylabel="range R0 (m)", title="temporal coherence")
     fig.colorbar(im, ax=a1)
     for k in range(min(rows.size, 20)):
-        a2.plot(np.asarray(t) / 60.0, disp[k], ".-")
-    a2.set(xlabel="time (min)", ylabel="LOS displacement (mm)", title=f"{rows.size} PS (first 20 shown)")
+        a2.plot(t_axis, disp[k], ".-")
+    a2.set(xlabel=t_label, ylabel="LOS displacement (mm)", title=f"{rows.size} PS (first 20 shown)")
     fig.tight_layout()
     from sarcli.io.images import atomic_path
 

@@ -11,12 +11,16 @@ from sarcli.errors import SarcliError
 
 
 def _parse_at(values: list[str]) -> list[tuple[float, float]]:
+    import math
+
     out = []
     for v in values:
         try:
             a, b = (float(x) for x in v.split(","))
         except ValueError:
             raise SarcliError(f"--at {v!r}: expected TIME_S,RANGE_M (zero-Doppler time, slant range)") from None
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise SarcliError(f"--at {v!r}: the time and range must be finite numbers")
         out.append((a, b))
     return out
 

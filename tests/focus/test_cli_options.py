@@ -1,0 +1,55 @@
+"""``sarcli focus`` / ``sarcli quality``: bad options are refused in one line before any work, and the
+--json report is honest (only the products written, one consistent set of timing keys)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+SCENE = Path(__file__).parent / "scenes" / "batch.toml"
+
+
+def _one_line_error(r, needle: str) -> None:
+    assert r.exit_code != 0
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("sarcli: error: ") and needle in lines[0], r.stderr
+    assert "Traceback" not in r.stderr + r.stdout
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--looks-az", "0", "--quicklook", "q.png"], "--looks-az"),
+    (["--looks-rg", "-2"], "--looks-rg"),
+    (["--crs", "EPSG:99999"], "--crs 'EPSG:99999'"),
+    (["--pixel-spacing", "-1"], "--pixel-spacing"),
+    (["--pixel-spacing", "nan"], "--pixel-spacing"),
+    (["--azimuth-bandwidth", "-5"], "--azimuth-bandwidth"),
+    (["--range-band-fraction", "2"], "--range-band-fraction"),
+    (["--range-band-fraction", "0"], "--range-band-fraction"),
+])
+def test_focus_bad_options_refused_before_any_work(cli, tmp_path, args, needle):
+    # the raw product does not even exist: the option check must come first (no "no --doppler given"
+    # line, no Doppler estimate, no focus), and nothing is written
+    out = tmp_path / "x.h5"
+    r = cli("focus", tmp_path / "missing.h5", "-o", out, *[a if a != "q.png" else str(tmp_path / a) for a in args])
+    _one_line_error(r, needle)
+    assert not out.exists() and not (tmp_path / "q.png").exists()
+
+
+def test_focus_json_timings_and_products_honest(cli, tmp_path):
+    raw = tmp_path / "raw.h5"
+    assert cli("simulate", SCENE, "-o", raw).exit_code == 0
+    r = cli("focus", raw, "-o", tmp_path / "slc.h5", "--fdc", "-6558", "--fr", "-1781", "--json")
+    assert r.exit_code == 0, r.stderr
+    rep = json.loads(r.stdout)
+    assert rep["products"] == {"slc": str(tmp_path / "slc.h5")}  # nothing that was not requested
+    t = rep["timings_s"]
+    assert all(k.endswith("_s") for k in t), t
+    assert "total" not in t and {"doppler_s", "focus_s", "statistics_and_products_s", "total_s"} <= set(t)
+    # the command total covers the focus, the Doppler and the products
+    assert t["total_s"] >= t["focus_s"] + t["doppler_s"] + t["statistics_and_products_s"] - 1e-6
+    q = cli("quality", tmp_path / "slc.h5", "--at", "nan,nan")
+    _one_line_error(q, "finite")
+    q = cli("quality", tmp_path / "slc.h5", "--at", "1,inf")
+    _one_line_error(q, "finite")
