@@ -112,15 +112,23 @@ def inverse_src_rate(f_eta_hz: np.ndarray, r_ref_m: float, v_mps: float, carrier
 
 
 @njit(parallel=True, cache=True, fastmath=True)
-def apply_range_filter_2d(x, h, f_tau, inv_ksrc):
-    """In place: x[k, m] *= h[m] * exp(-j pi f_tau[m]^2 inv_ksrc[k]) (2-D spectrum, azimuth rows k).
+def apply_range_filter_2d(x, h, f_tau, inv_ksrc, out):
+    """out[k, j(m)] = x[k, m] * h[m] * exp(-j pi f_tau[m]^2 inv_ksrc[k]) (2-D spectrum, azimuth rows k).
 
+    ``out`` has n_out >= n_f columns: the positive-frequency half m < (n_f + 1) // 2 keeps its column,
+    the negative half moves to the end (j = m + n_out - n_f) and the columns between are zeroed, i.e.
+    Fourier zero padding: the IFFT of ``out`` is the filtered row interpolated on an n_out / n_f finer
+    grid. ``out`` may be ``x`` when n_out == n_f (in place).
     The phase is quadratic in m on each half of the FFT frequency axis (f_tau linear there), so the
     phasor is advanced by a second-order recurrence (two complex multiplies per sample instead of a
     sine and cosine), restarted exactly every 64 samples: drift below 1e-12 rad.
     """
     na, nf = x.shape
+    half = (nf + 1) // 2
+    gap = out.shape[1] - nf
     for k in prange(na):
+        for q in range(half, half + gap):
+            out[k, q] = 0.0
         a = -np.pi * inv_ksrc[k]
         m = 0
         while m < nf:
@@ -134,16 +142,19 @@ def apply_range_filter_2d(x, h, f_tau, inv_ksrc):
                 d2 = 2.0 * a * df * df  # its increment per sample
                 curv = complex(np.cos(d2), np.sin(d2))
                 for q in range(m, e):
-                    x[k, q] = x[k, q] * (h[q] * cur)
+                    out[k, q if q < half else q + gap] = x[k, q] * (h[q] * cur)
                     cur *= step
                     step *= curv
             else:
                 for q in range(m, e):
                     ph = a * f_tau[q] * f_tau[q]
-                    x[k, q] = x[k, q] * (h[q] * complex(np.cos(ph), np.sin(ph)))
+                    out[k, q if q < half else q + gap] = x[k, q] * (h[q] * complex(np.cos(ph), np.sin(ph)))
             m = e
 
 
-def apply_range_filter_2d_numpy(x: np.ndarray, h: np.ndarray, f_tau: np.ndarray, inv_ksrc: np.ndarray) -> np.ndarray:
-    """Plain-numpy reference of :func:`apply_range_filter_2d` (returns a new array)."""
-    return x * (h[None, :] * np.exp(-1j * np.pi * inv_ksrc[:, None] * f_tau[None, :] ** 2))
+def apply_range_filter_2d_numpy(x: np.ndarray, h: np.ndarray, f_tau: np.ndarray, inv_ksrc: np.ndarray,
+                                n_out: int) -> np.ndarray:
+    """Plain-numpy reference of :func:`apply_range_filter_2d` (returns the n_out-column array)."""
+    y = x * (h[None, :] * np.exp(-1j * np.pi * inv_ksrc[:, None] * f_tau[None, :] ** 2))
+    half = (x.shape[1] + 1) // 2
+    return np.concatenate([y[:, :half], np.zeros((x.shape[0], n_out - x.shape[1]), y.dtype), y[:, half:]], axis=1)

@@ -4,15 +4,21 @@ Per block of output lines [s, e) the raw lines [s - P, e + P) are read (zeros be
 P = ceil(aperture/2 + residual shift) lines so that every output line sees its whole processed
 aperture, and processed as
 
-1. AGC undone (x 10**(agc_db/20) per line), range FFT (linear convolution length), matched filter
-   (:mod:`sarcli.focus.rangecomp`), range IFFT -> range-compressed lines on the raw range grid,
-   in chunks of CHUNK lines written into the block;
-2. azimuth FFT (block length N >= e - s + 2P, in column chunks);
-3. per chunk of azimuth-frequency rows inside the processed band: range FFT (64-sample guard),
-   optional SRC at the mid-swath range, 2x Fourier upsampling in range (knob), range IFFT, then
+1. AGC undone (x 10**(agc_db/20) per line), range FFT of length L >= n_samples + n_ref/2 + 64 in
+   place (L: the shortest length whose circular correlation with the centred reference equals the
+   linear one on the n_samples output samples, plus a guard for the SRC impulse response);
+2. azimuth FFT (block length N >= e - s + 2P) in place: the block is now the 2-D spectrum;
+3. per chunk of azimuth-frequency rows inside the processed band, ONE pass in the 2-D frequency domain
+   (:func:`sarcli.focus.rangecomp.apply_range_filter_2d`): range matched filter x optional SRC at the
+   mid-swath range x Fourier zero padding to ``rcmc_oversample`` x L (2x upsampling, knob); range IFFT;
 4. RCMC + azimuth matched filter with the range-dependent centroid and rate of that block
-   (:mod:`sarcli.focus.rcmc`), evaluated from the Doppler model at the block's centre time;
-5. azimuth IFFT; lines [P, P + e - s) of the block are output lines [s, e).
+   (:mod:`sarcli.focus.rcmc`), evaluated from the Doppler model at the block's centre time, written
+   into the first n_samples columns of the block;
+5. azimuth IFFT of those columns; lines [P, P + e - s) of the block are output lines [s, e).
+
+Range compression, SRC and upsampling thus cost one range FFT and one range IFFT (the former design
+compressed, transformed back and forth again for SRC and upsampling: two more range passes).
+FFT lengths are 5-smooth (:func:`smooth_len`): pocketfft is markedly slower on factors 7 and 11.
 
 Output geometry: column i is closest-approach slant range ``r_first + i dr`` (the raw range grid); line
 j has ZERO-DOPPLER time ``t_raw[j] - shift/PRF``, where ``shift`` (integer lines) is the beam-centre
@@ -20,8 +26,8 @@ offset Delta = R0 tan(theta)/V at mid-swath and scene centre (:mod:`sarcli.focus
 every target lands within a few lines of its raw data, so squinted scenes (centroids of several PRFs)
 need no more overlap than broadside ones. Lines closer than half an aperture to the scene ends see
 only part of their aperture (``first_full_line`` / ``last_full_line``; a warning when none is whole).
-Peak extra memory per block: the N x n_samples block (complex64) plus row/column chunks
-(bench: 3.5 x a 1536 x 2048 input including the output image).
+Peak extra memory per block: the N x L block (complex64) plus a chunk of upsampled rows (bench_focus
+reports it against a 1536 x 2048 input, including the output image).
 """
 
 from __future__ import annotations
@@ -41,7 +47,6 @@ from sarcli.focus.kinematics import aperture_time, beam_centre_offset, velocity_
 from sarcli.focus.rangecomp import (
     C,
     apply_range_filter_2d,
-    compress_lines,
     inverse_src_rate,
     range_filter,
     reference_pulse,
@@ -51,8 +56,21 @@ from sarcli.focus.windows import parse_window, window_table
 from sarcli.io.raw import RawProduct
 from sarcli.io.slc import SLC, DopplerUsed
 
-SRC_GUARD = 64
-CHUNK = 256  # rows per chunk of the row-wise steps (range compression, SRC + RCMC)
+RANGE_GUARD = 64  # range samples beyond the correlation's wrap-free length (SRC impulse response)
+CHUNK = 128  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass
+
+
+def smooth_len(n: int) -> int:
+    """Smallest 5-smooth integer (2^a 3^b 5^c) >= n: a fast pocketfft length."""
+    n = max(1, int(n))
+    while True:
+        m = n
+        for q in (2, 3, 5):
+            while m % q == 0:
+                m //= q
+        if m == 1:
+            return n
+        n += 1
 
 
 @dataclass(frozen=True)
@@ -231,64 +249,55 @@ def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan
     resid = max(float(np.max(np.abs(o - shift))) for o in offsets)
     aperture = float(np.max(aperture_time(np.min(fr_abs, axis=0), ba))) * prf
     pad = int(math.ceil(0.5 * aperture + resid)) + 4
-    n_fft_az = sfft.next_fast_len(max(k.block_lines, 4 * pad) if n_lines + 2 * pad > k.block_lines
-                                  else n_lines + 2 * pad)
+    n_fft_az = smooth_len(max(k.block_lines, 4 * pad) if n_lines + 2 * pad > k.block_lines
+                          else n_lines + 2 * pad)
     n_valid = min(n_lines, n_fft_az - 2 * pad)
     n_ref = reference_pulse(radar, raw.replica if k.use_replica else None).size
-    n_fft_r = sfft.next_fast_len(len(ranges) + n_ref - 1)
+    n_fft_r = smooth_len(len(ranges) + n_ref // 2 + RANGE_GUARD)
     return _Plan(prf, ranges, lam, ba, shift, pad, n_fft_az, n_valid, n_fft_r, aperture)
 
 
-def _fft_columns(y: np.ndarray, inverse: bool, workers: int, cols: int = 256) -> None:
-    """In place azimuth (axis 0) FFT in column chunks (scipy copies a whole array for axis 0)."""
-    f = sfft.ifft if inverse else sfft.fft
-    for c in range(0, y.shape[1], cols):
-        y[:, c:c + cols] = f(y[:, c:c + cols], axis=0, workers=workers)
+def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int) -> None:
+    """FFT of ``y`` along ``axis`` in place (scipy's pocketfft writes into ``y`` with overwrite_x)."""
+    r = (sfft.ifft if inverse else sfft.fft)(y, axis=axis, overwrite_x=True, workers=workers)
+    if not np.may_share_memory(r, y):
+        y[...] = r
 
 
-def _src_rcmc_rows(y, factor, inv_k, f_bin, p, fs, v, fdc, dt, ph0, wtab, kind, table, workers, timings,
-                   rows=CHUNK):
-    """SRC, range upsampling and RCMC + azimuth filter of the range-Doppler block ``y``, in place.
+def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wtab, kind, table, workers, timings,
+                      rows=CHUNK):
+    """Range filter (+ SRC), upsampling and RCMC + azimuth filter of the 2-D spectrum ``y`` (N x L).
 
-    Every azimuth-frequency row is independent, so rows are processed in chunks: range FFT (64-sample
-    guard against wrap-around), the SRC phase ``exp(-j pi f_tau^2 inv_k[row])`` (zero: none), zero
-    padding in the middle of the spectrum to ``factor`` x the length (Fourier interpolation), IFFT, and
-    the kernel interpolates on the ``factor`` x finer grid back into ``y``. With factor 2 the data sit
-    below a quarter of the sampling rate, where the windowed sinc is flat (a Radarsat-1 chirp is sampled
-    at only 1.07 x its band: bench). ``factor`` is folded into the window table (the IFFT of the longer
-    spectrum divides by factor x n2).
+    Every azimuth-frequency row is independent, so rows are processed in chunks: the matched filter
+    ``h`` times the SRC phase ``exp(-j pi f_tau^2 inv_k[row])`` (zero: none), zero padding in the
+    middle of the spectrum to ``factor`` x L (Fourier interpolation), IFFT, and the kernel interpolates
+    on the ``factor`` x finer grid into ``y[:, :nr]`` (range-Doppler domain, raw range grid). With
+    factor 2 the data sit below a quarter of the sampling rate, where the windowed sinc is flat (a
+    Radarsat-1 chirp is sampled at only 1.07 x its band: bench). ``factor`` is folded into the window
+    table (the IFFT of the longer spectrum divides by factor x L instead of L).
     """
-    na, nr = y.shape
-    n2 = sfft.next_fast_len(nr + SRC_GUARD)
-    h = (n2 + 1) // 2
-    ones = np.ones(n2, y.dtype)
-    f_tau = sfft.fftfreq(n2, 1.0 / fs)
+    n_fft = y.shape[1]
+    f_tau = sfft.fftfreq(n_fft, 1.0 / fs)
     w = wtab * factor
     dr = C / (2.0 * fs)
+    out = y[:, :nr]
     # rows whose frequency lies outside the processed band at every range are zero: skip their FFTs
     off = f_bin[:, None] - fdc[None, ::16]
     off -= p.prf * np.floor(off / p.prf + 0.5)
     active = np.any(np.abs(off) <= 0.5 * p.ba * (1.0 + 1e-9), axis=1)
-    y[~active] = 0.0
+    out[~active] = 0.0
     edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
     chunks = [(c, min(b, c + rows)) for a, b in zip(edges[::2], edges[1::2], strict=True) for c in range(a, b, rows)]
+    buf = np.empty((min(rows, y.shape[0]), factor * n_fft), y.dtype)
     for c, d in chunks:
         t0 = time.perf_counter()
-        zz = np.zeros((d - c, n2), y.dtype)
-        zz[:, :nr] = y[c:d]
-        zz = sfft.fft(zz, axis=1, overwrite_x=True, workers=workers)
-        if np.any(inv_k[c:d]):
-            apply_range_filter_2d(zz, ones, f_tau, inv_k[c:d])
-        if factor > 1:
-            up = np.zeros((d - c, factor * n2), y.dtype)
-            up[:, :h] = zz[:, :h]
-            up[:, factor * n2 - (n2 - h):] = zz[:, h:]
-            zz = up
-        zz = sfft.ifft(zz, axis=1, overwrite_x=True, workers=workers)
+        up = buf[:d - c]
+        apply_range_filter_2d(y[c:d], h, f_tau, inv_k[c:d], up)
+        _fft_inplace(up, 1, True, workers)
         t1 = time.perf_counter()
-        rcmc_azimuth(zz, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
-                     p.prf, p.ba, w, kind, table, p.shift, y[c:d])
-        timings["src_s"] += t1 - t0
+        rcmc_azimuth(up, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
+                     p.prf, p.ba, w, kind, table, p.shift, out[c:d])
+        timings["range_filter_ifft_s"] += t1 - t0
         timings["rcmc_azimuth_s"] += time.perf_counter() - t1
 
 
@@ -302,7 +311,7 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
     """
     k = knobs
     t_start = time.perf_counter()
-    timings = {"range_compression_s": 0.0, "azimuth_fft_s": 0.0, "src_s": 0.0, "rcmc_azimuth_s": 0.0,
+    timings = {"range_fft_s": 0.0, "azimuth_fft_s": 0.0, "range_filter_ifft_s": 0.0, "rcmc_azimuth_s": 0.0,
                "azimuth_ifft_s": 0.0, "io_s": 0.0}
     radar = raw.radar
     n_lines = shape[0]
@@ -318,7 +327,6 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
     kind, table = table_for(k.rcmc)
     table = table.astype(np.float32 if k.precision == "single" else np.float64)  # single: complex64 taps
     f_bin = sfft.fftfreq(p.n_fft_az, 1.0 / p.prf)
-    dr = C / (2.0 * radar.range_sampling_rate_hz)
     gain = raw.line_gain()
     t_raw = raw.azimuth_time
     dt = 1.0 / p.prf
@@ -343,16 +351,17 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
         if data.shape != (z - a, nr):
             raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
         t0 = time.perf_counter()
-        y = np.zeros((p.n_fft_az, nr), cdt)
+        y = np.zeros((p.n_fft_az, p.n_fft_r), cdt)
         off = a - (s - p.pad)
-        for c in range(0, z - a, CHUNK):  # in row chunks: no second block-sized buffer
-            d = min(z - a, c + CHUNK)
-            y[off + c:off + d] = compress_lines(data[c:d] if gain is None else data[c:d] * gain[a + c:a + d, None],
-                                                h, nr, k.workers)
+        lines = y[off:off + z - a]
+        lines[:, :nr] = data
         del data
-        timings["range_compression_s"] += time.perf_counter() - t0
+        if gain is not None:
+            lines[:, :nr] *= gain[a:z, None]
+        _fft_inplace(lines, 1, False, k.workers)
+        timings["range_fft_s"] += time.perf_counter() - t0
         t0 = time.perf_counter()
-        _fft_columns(y, inverse=False, workers=k.workers)
+        _fft_inplace(y, 0, False, k.workers)
         timings["azimuth_fft_s"] += time.perf_counter() - t0
         tb = float(t_raw[0] + 0.5 * (s + e - 1) * dt)
         fdc, fr, v, sq = doppler_on_grid(doppler, p.ranges, tb, p.wavelength)
@@ -363,24 +372,19 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
         frs.append(fr)
         vs.append(v)
         dts.append(dt_orbit)
+        inv_k = np.zeros(p.n_fft_az)
+        if k.src:
+            off_f = f_bin - fdc[nr // 2]
+            f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
+            inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
+        _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, radar.range_sampling_rate_hz, k.rcmc_oversample, v, fdc,
+                          dt_orbit, ph_orbit, wtab, kind, table, k.workers, timings)
+        img = y[:, :nr]
         t0 = time.perf_counter()
-        if k.src or k.rcmc_oversample > 1:
-            inv_k = np.zeros(p.n_fft_az)
-            if k.src:
-                off_f = f_bin - fdc[nr // 2]
-                f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
-                inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
-            _src_rcmc_rows(y, k.rcmc_oversample, inv_k, f_bin, p, radar.range_sampling_rate_hz, v, fdc, dt_orbit,
-                           ph_orbit, wtab, kind, table, k.workers, timings)
-        else:
-            rcmc_azimuth(y, f_bin, float(p.ranges[0]), dr, p.ranges, v, fdc, dt_orbit, ph_orbit, p.wavelength,
-                         p.prf, p.ba, wtab, kind, table, p.shift, y)
-            timings["rcmc_azimuth_s"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        _fft_columns(y, inverse=True, workers=k.workers)
+        _fft_inplace(img, 0, True, k.workers)
         timings["azimuth_ifft_s"] += time.perf_counter() - t0
         t0 = time.perf_counter()
-        sink(s, y[p.pad:p.pad + (e - s)].astype(np.complex64, copy=False))
+        sink(s, img[p.pad:p.pad + (e - s)].astype(np.complex64, copy=False))
         timings["io_s"] += time.perf_counter() - t0
         if on_block is not None:
             on_block(b + 1, n_blocks)

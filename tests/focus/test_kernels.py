@@ -51,8 +51,13 @@ def test_range_filter_2d_matches_numpy():
     h = np.exp(1j * rng.uniform(0, 6, 40))
     f = np.fft.fftfreq(40, 1 / 30e6)
     ik = rng.uniform(0, 1e-14, 16)
-    ref = apply_range_filter_2d_numpy(x, h, f, ik)
-    apply_range_filter_2d(x, h, f, ik)
+    for n_out in (41, 80, 97):  # zero padding (Fourier interpolation) into a longer row
+        ref = apply_range_filter_2d_numpy(x, h, f, ik, n_out)
+        out = np.full((16, n_out), np.nan, complex)
+        apply_range_filter_2d(x, h, f, ik, out)
+        np.testing.assert_allclose(out, ref, rtol=1e-12, atol=0)
+    ref = apply_range_filter_2d_numpy(x, h, f, ik, 40)
+    apply_range_filter_2d(x, h, f, ik, x)  # in place
     np.testing.assert_allclose(x, ref, rtol=1e-12)
 
 
