@@ -103,14 +103,19 @@ def test_montecarlo_reduced_is_reproducible(tmp_path, scene_file, cli):
 
 @pytest.mark.slow
 def test_montecarlo_paper_bar_reduced(cli):
-    """The paper's bar (<= 0.2 % for SNR >= 10 dB), one run per SNR (the bench runs 50)."""
-    r = cli("ati", "montecarlo", "--scene", PAPER_SCENE, "--runs", "1", "--snr", "10",
+    """The paper's bar (<= 0.2 % for SNR >= 10 dB), one run per SNR (the bench runs 50); at -5 dB the
+    errors grow but stay within a few reported sigmas (graceful degradation, honest uncertainty)."""
+    r = cli("ati", "montecarlo", "--scene", PAPER_SCENE, "--runs", "1", "--snr", "-5,10",
             "--seed", "3", "--json")
     assert r.exit_code == 0, r.stderr
-    for e in json.loads(r.stdout)["per_snr"]:
-        assert e["missed"] == 0
-        for k in ("vy", "x0", "y0"):
-            assert e[f"{k}_max_rel"] < 0.002, (e["snr_db"], k, e[f"{k}_max_rel"])
+    low, high = json.loads(r.stdout)["per_snr"]
+    for e in (low, high):
+        assert e["missed"] == 0 and e["failed"] == 0
+    for k in ("vy", "x0", "y0"):
+        assert high[f"{k}_max_rel"] < 0.002, (k, high[f"{k}_max_rel"])
+        assert low[f"{k}_max_rel"] < 4 * low[f"{k}_sigma_mean_rel"], (k, low)
+    for k in ("vy", "y0"):   # (x0's sigma is dominated by the range quantization at every SNR)
+        assert low[f"{k}_sigma_mean_rel"] > high[f"{k}_sigma_mean_rel"]
 
 
 def test_bad_snr_spec_is_one_line(cli):
