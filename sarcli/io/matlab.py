@@ -60,8 +60,8 @@ def _load(path: Path, what: str) -> dict[str, Any]:
         return scipy.io.loadmat(path, squeeze_me=True)
     except NotImplementedError:
         raise FormatError(f"{path}: MATLAB v7.3 (HDF5) {what} files are not supported; save with -v7") from None
-    except (ValueError, TypeError, OSError) as e:
-        raise FormatError(f"{path}: not a readable MATLAB {what} file ({e.__class__.__name__})") from None
+    except (scipy.io.matlab.MatReadError, ValueError, TypeError, OSError, EOFError) as e:
+        raise FormatError(f"{path}: not a readable MATLAB {what} file ({e})") from None
 
 
 def _scalar(params: dict, key: str, path: Path) -> float:

@@ -9,6 +9,8 @@ import typer
 from sarcli.cli.common import emit_json, info
 from sarcli.errors import SarcliError
 
+F3_PULSES_KNOWN = (8, 9)  # the two published readings of beam F3's pulses in flight (ISCE, ASF MapReady)
+
 
 def ingest(
     leader: Path = typer.Argument(None, help="CEOS leader file (LEA_01.001) or a CEOS scene folder."),
@@ -44,6 +46,11 @@ def ingest(
 
     if compression not in (None, "gzip", "lzf"):
         raise SarcliError(f"--compression must be gzip or lzf, got {compression!r}")
+    if max_gap < 0:
+        raise SarcliError(f"--max-gap must be a number of lines >= 0, got {max_gap}")
+    if f3_pulses not in F3_PULSES_KNOWN:
+        raise SarcliError(f"--f3-pulses must be {' or '.join(map(str, F3_PULSES_KNOWN))} (pulses in flight of beam F3 "
+                          f"per ISCE or ASF MapReady), got {f3_pulses}")
     if matlab is not None:
         if leader is not None or data is not None:
             raise SarcliError("give either CEOS files or --matlab/--params, not both")

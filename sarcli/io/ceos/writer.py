@@ -56,6 +56,9 @@ class CeosExportError(SarcliError):
     """The product cannot be represented in Radarsat-1 CEOS RAW."""
 
 
+SCENE_FILES = ("VDF_DAT.001", "LEA_01.001", "DAT_01.001", "TRA_01.001")  # every file write_ceos writes
+
+
 def _refuse(msg: str) -> CeosExportError:
     return CeosExportError(f"cannot write CEOS RAW: {msg}")
 
@@ -209,29 +212,41 @@ def _volume(n_lines: int) -> bytes:
     return b"".join(bytes(r) for r in recs)
 
 
+def check_representable(n_channels: int, n_samples: int, four_bit: bool, fs: float, prf: float, tau0: float,
+                        beam_hint: int | None = None) -> tuple[int, int, tuple[int, int, int]]:
+    """Refuse (one line, :class:`CeosExportError`) what CEOS RAW cannot hold, from the settings alone.
+
+    Returns (ADC code, PRF code, (beam, pulses in flight, window start code)). Used by
+    :func:`write_ceos` and, before any simulation, by ``sarcli simulate --format ceos``.
+    """
+    if n_channels != 1:
+        raise _refuse(f"Radarsat-1 RAW holds one receive channel; the product has {n_channels}")
+    if n_samples % 6 or n_samples > 6 * 4096:
+        raise _refuse(f"{n_samples} samples per line is not 6 (code+1) for a 12-bit code (pad to a multiple of 6)")
+    if not four_bit:
+        raise _refuse("echo is not 4-bit quantized (odd levels -15..15); simulate with the quantization effect")
+    adc = _adc_code(fs)
+    prf_code = _prf_code(prf, adc)
+    return adc, prf_code, _window(tau0, prf_code, adc, beam_hint)
+
+
 def write_ceos(out_dir: str | os.PathLike, raw: RawProduct) -> tuple[Path, Path]:
     """Write ``raw`` as a Radarsat-1 CEOS RAW scene folder; return (leader path, data path).
 
     Refuses (one line, :class:`CeosExportError`) a product that CEOS RAW cannot hold exactly (module
     docstring). ``out_dir`` is created if needed (its parent must exist).
     """
-    if raw.echo_channels is not None:
-        raise _refuse("Radarsat-1 RAW holds one receive channel; the product has several")
     n, ns = raw.echo.shape
-    if ns % 6 or ns > 6 * 4096:
-        raise _refuse(f"{ns} samples per line is not 6 (code+1) for a 12-bit code (pad to a multiple of 6)")
-    if not is_four_bit(raw.echo):
-        raise _refuse("echo is not 4-bit quantized (odd levels -15..15); simulate with the quantization effect")
+    r = raw.radar
+    adc, prf_code, (beam, _, window_code) = check_representable(
+        1 if raw.echo_channels is None else 2, ns, is_four_bit(raw.echo), r.range_sampling_rate_hz, r.prf_hz,
+        r.window_start_s, raw.extra_attrs.get("ceos_beam_number"))
     if raw.prf_per_line is not None and np.ptp(raw.prf_per_line) > 0:
         raise _refuse("the PRF varies along the scene; sarcli's CEOS writer needs one PRF")
     if raw.agc_db is not None:
         agc = np.asarray(raw.agc_db, np.float64)
         if np.any(agc != np.rint(agc)) or agc.min() < 0 or agc.max() > 63:
             raise _refuse("AGC must be whole dB in 0..63 (6-bit aux field)")
-    r = raw.radar
-    adc = _adc_code(r.range_sampling_rate_hz)
-    prf_code = _prf_code(r.prf_hz, adc)
-    beam, _, window_code = _window(r.window_start_s, prf_code, adc, raw.extra_attrs.get("ceos_beam_number"))
     _pulse_grid(np.asarray(raw.azimuth_time, np.float64), r.prf_hz)
     sv = _orbit_record(raw)
     rep = _replica_levels(raw, adc)
@@ -264,8 +279,9 @@ def write_ceos(out_dir: str | os.PathLike, raw: RawProduct) -> tuple[Path, Path]
     if not folder.parent.is_dir():
         raise _refuse(f"output folder {folder.parent} does not exist")
     folder.mkdir(exist_ok=True)
-    lea = _atomic_write(folder, "LEA_01.001", [build_leader(info, SOFTWARE_ID)])
-    dat = _atomic_write(folder, "DAT_01.001", _data_records(raw, times_us, year, doy, codes, rep))
-    _atomic_write(folder, "TRA_01.001", [bytes(F.file_descriptor(720, 3, "TRA_01.001", SOFTWARE_ID))])
-    _atomic_write(folder, "VDF_DAT.001", [_volume(n)])
+    vdf, lea_name, dat_name, tra = SCENE_FILES
+    lea = _atomic_write(folder, lea_name, [build_leader(info, SOFTWARE_ID)])
+    dat = _atomic_write(folder, dat_name, _data_records(raw, times_us, year, doy, codes, rep))
+    _atomic_write(folder, tra, [bytes(F.file_descriptor(720, 3, tra, SOFTWARE_ID))])
+    _atomic_write(folder, vdf, [_volume(n)])
     return lea, dat
