@@ -9,6 +9,8 @@ Sections (all measured in one run, same machine):
   E. Hermite order vs fdc / fr error (against the simulator's truth) and interpolation cost.
   F. Real data: the Vancouver block (baseband per range block with quality, 512 vs 1536 lines,
      data-only ambiguity + confidence, map-drift rate).
+  G. The README examples: samples/rs1_clutter.toml (2048 lines, 4-bit AGC) and the 512-line test scene,
+     scene-centre and RMS centroid error against the truth.
 Run: ``.venv/bin/python -m bench.bench_doppler`` (writes bench/results/bench_doppler.md|json|png).
 """
 
@@ -114,13 +116,41 @@ def section_estimators(out: dict, raw) -> str:
                      "t_estimator_ms": t_est * 1e3, "t_pipeline_s": t_all})
     m = estimate_doppler(raw, fr_method="mapdrift")
     md_err = float(np.max(np.abs(m.fr(rho, 0.0) / tr - 1)))
+    md = m.summary["fr_info"]["mapdrift"]
+    air = _mapdrift_airborne()
     out["estimators"] = data
     out["mapdrift_fr_max_rel"] = md_err
+    out["mapdrift_velocity_mps"] = [md["velocity_mps"], md["velocity_sigma_mps"]]
+    out["mapdrift_airborne"] = air
     return (f"## C. Estimators on a simulated clutter scene ({raw.echo.shape[0]} x {raw.echo.shape[1]}, land / bright "
             "strip / sea, antenna pattern, 10 dB SNR, earth rotation, pitch 0.03 deg, yaw 0.004 deg)\n\n"
             + markdown_table(["estimator", "fdc RMS error (Hz)", "% PRF", "fr max rel. error", "estimator time (ms)",
                               "whole estimate_doppler (s)"], rows)
-            + f"\nData-driven rate (map-drift, no orbit used for fr): max relative error {md_err:.2e}.\n")
+            + f"\nData-driven rate (map-drift, no orbit used for fr; one effective velocity Vr = "
+              f"{md['velocity_mps']:.2f} +- {md['velocity_sigma_mps']:.2f} m/s, fr = -2 Vr^2/(lam R)): max relative "
+              f"error {md_err:.2e} over the swath.\n\n"
+              f"Airborne scene (tests/doppler/scenes/airborne_clutter.toml, straight flight at 2000 m/s, LOCAL frame, "
+              f"start 10 % off): Vr = {air['velocity_mps']:.3f} +- {air['velocity_sigma_mps']:.3f} m/s; max relative "
+              f"error of fr against the truth -2 V^2/(lam R) {air['swath_max_rel']:.1e} over the swath "
+              f"({air['range_m'][0] / 1e3:.1f}-{air['range_m'][1] / 1e3:.1f} km), {air['far_max_rel']:.1e} from 0.5x "
+              "the near to 2x the far range (the 1/R law is kept outside the swath).\n")
+
+
+def _mapdrift_airborne() -> dict:
+    """Map-drift effective velocity on the airborne clutter scene (true fr = -2 V^2/(lam R), V = 2000 m/s)."""
+    from sarcli.doppler.api import estimate_doppler
+    from tests.doppler.conftest import SCENES, simulate_text
+
+    raw = simulate_text((SCENES / "airborne_clutter.toml").read_text())
+    raw = dataclasses.replace(raw, radar=dataclasses.replace(raw.radar, platform_velocity_mps=None))
+    rho, lam = raw.slant_range(), raw.radar.wavelength_m
+    m = estimate_doppler(raw, velocity_guess_mps=2200.0, ambiguity_value=0)
+    far = np.linspace(0.5 * rho[0], 2.0 * rho[-1], 50)
+    md = m.summary["fr_info"]["mapdrift"]
+    return {"velocity_mps": md["velocity_mps"], "velocity_sigma_mps": md["velocity_sigma_mps"],
+            "range_m": [float(rho[0]), float(rho[-1])],
+            "swath_max_rel": float(np.max(np.abs(m.fr(rho, 0.0) / raw.truth["doppler_rate_hz_per_s"] - 1))),
+            "far_max_rel": float(np.max(np.abs(m.fr(far, 0.0) / (-2 * 2000.0**2 / (lam * far)) - 1)))}
 
 
 def section_models(out: dict, raw) -> str:
@@ -212,8 +242,13 @@ def section_real(out: dict) -> str:
     do = s["data_only"]
     lines = "\n".join(f"- {e['method'].upper()}: fdc {e['fdc_hz']:.0f} +- {e['sigma_hz']:.0f} Hz -> ambiguity "
                       f"{e['ambiguity']}, confidence {e['confidence']:.2f}" for e in do)
-    md = s["fr_info"].get("mapdrift", [])
-    mdl = "; ".join(f"{x['range_m'] / 1e3:.1f} km: {x['fr_hz_per_s']:.1f} Hz/s" for x in md if x["used"])
+    md = s["fr_info"]["mapdrift"]
+    rho = raw.slant_range()
+    mdl = "; ".join(f"{x['range_m'] / 1e3:.1f} km: {x['fr_hz_per_s']:.1f} Hz/s (model {x['model_hz_per_s']:.1f})"
+                    for x in md["segments"] if x["used"])
+    mdl += (f". One effective velocity Vr = {md['velocity_mps']:.1f} +- {md['velocity_sigma_mps']:.1f} m/s: fr = "
+            f"{float(m.fr(rho[0], s['scene_time_s'])):.1f} Hz/s at the near edge ({rho[0] / 1e3:.2f} km) to "
+            f"{float(m.fr(rho[-1], s['scene_time_s'])):.1f} Hz/s at the far edge ({rho[-1] / 1e3:.2f} km)")
     return ("## F. Real data: Vancouver block (1536 x 2048, RADARSAT-1 fine beam)\n\n"
             + f"Scene baseband centroid {s['fdc_baseband_hz']:.1f} Hz (quality {s['quality']:.3f}).\n\n"
             + markdown_table(["range block (128 samples)", "fdc_bb 1536 lines (Hz)", "quality",
@@ -225,6 +260,34 @@ def section_real(out: dict) -> str:
               f"{s['fdc_hz']:.0f} Hz at the scene centre)\n\n{lines}\n\n"
             + f"Data-driven Doppler rate (map-drift): {mdl}; scene value {s['fr_hz_per_s']:.1f} Hz/s at "
               f"{s['scene_range_m'] / 1e3:.1f} km. estimate_doppler took {t_est:.1f} s.\n")
+
+
+def section_examples(out: dict) -> str:
+    from sarcli.doppler.api import estimate_doppler
+    from sarcli.sim.scene import parse_scene
+    from sarcli.sim.stripmap import simulate
+    from tests.doppler.conftest import scene_text, simulate_text
+
+    sample = Path(__file__).resolve().parents[1] / "samples" / "rs1_clutter.toml"
+    scenes = [("samples/rs1_clutter.toml", simulate(parse_scene(sample.read_text(), str(sample)))),
+              ("tests/doppler/scenes/rs1_clutter.toml (512 lines)", simulate_text(scene_text()))]
+    rows, data = [], []
+    for name, raw in scenes:
+        tf, rho, prf = raw.truth["doppler_centroid_hz"], raw.slant_range(), raw.radar.prf_hz
+        tt = float(raw.truth["doppler_truth_time_s"])
+        for blocks in ((2048, 128), (512, 96)):
+            m = estimate_doppler(raw, az_block=blocks[0], rg_block=blocks[1])
+            s = m.summary
+            f_true = float(np.interp(s["scene_range_m"], rho, tf))
+            rms = float(np.sqrt(np.mean((m.fdc(rho, tt) - tf) ** 2)))
+            rows.append([name, f"{raw.echo.shape[0]} x {raw.echo.shape[1]}", f"{blocks[0]} x {blocks[1]}",
+                         s["fdc_hz"], f_true, 100 * (s["fdc_hz"] - f_true) / prf, 100 * rms / prf, s["fr_hz_per_s"]])
+            data.append(dict(zip(("scene", "shape", "blocks", "fdc_hz", "truth_hz", "centre_err_pct_prf",
+                                  "rms_err_pct_prf", "fr_hz_per_s"), rows[-1], strict=True)))
+    out["examples"] = data
+    return ("## G. README examples (CDE, orbit ambiguity; truth at the scene-centre time)\n\n"
+            + markdown_table(["scene", "lines x samples", "blocks", "fdc at scene centre (Hz)", "truth (Hz)",
+                              "error (% PRF)", "RMS error over range (% PRF)", "fr (Hz/s)"], rows) + "\n")
 
 
 def _plot(out: dict) -> None:
@@ -257,7 +320,8 @@ def main() -> None:
     out: dict = {}
     parts = [section_throughput(out), section_blocks(out)]
     raw = _scene()
-    parts += [section_estimators(out, raw), section_models(out, raw), section_hermite(out, raw), section_real(out)]
+    parts += [section_estimators(out, raw), section_models(out, raw), section_hermite(out, raw), section_real(out),
+              section_examples(out)]
     RESULTS.mkdir(parents=True, exist_ok=True)
     _plot(out)
     write_results("bench_doppler", "# Doppler benchmark\n\n" + "\n".join(parts) + "\nPlot: bench_doppler.png\n",

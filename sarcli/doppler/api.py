@@ -13,7 +13,8 @@ Pipeline
    outlier flags (``polyfit``).
 5. Doppler rate: exactly -(2/lam) d2R/deta2 at the target of the fitted absolute centroid (orbit),
    also the seed's route (look angle re-solved from fdc) for comparison; without an orbit, map-drift
-   autofocus (``mapdrift``) per range segment.
+   autofocus (``mapdrift``) per range segment and one effective velocity fitted over the swath,
+   fr = -2 Vr^2/(lam R) at every range.
 
 Block coordinates: slant range of the block's centre sample (raw sample k <-> two-way time
 window_start + k/fs; for the raw echo, energy at sample k comes from scatterers at that range, the
@@ -304,18 +305,29 @@ def _central_lines(echo: np.ndarray, max_lines: int) -> np.ndarray:
 
 
 def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_seg: int, max_lines: int):
-    """Map-drift rate per range segment over the central ``max_lines`` lines; fr*R fitted linearly in
-    range over the segments that converged to within 30 % of their start value (constant in time)."""
+    """Map-drift rate per range segment over the central ``max_lines`` lines, and ONE effective velocity
+    for the swath: fr(R) = -2 Vr^2/(lam R) (flat-earth / effective-velocity model, constant in time).
+
+    Fit: c = -2 Vr^2/lam by weighted least squares of the per-segment rates fr_k against c/R_k over the
+    segments that converged to within 30 % of their start value, weights w_k = the segment's number of
+    range samples (the drift sums independent range bins): c = sum w fr/R / sum w/R^2. Its standard
+    error comes from the scatter of the segments about the model, s^2 = sum w (fr - c/R)^2 / (n - 1),
+    sigma_c = s / sqrt(sum w/R^2); sigma_Vr = lam sigma_c / (4 Vr) (from Vr = sqrt(-c lam/2)); not
+    defined for a single segment. The model is c R^-1 at every range (no clipping, no flat hold): a
+    free slope (fr R linear in R) fitted to a few noisy segments of a narrow swath had the wrong sign on
+    the Vancouver block, and a 1/R law cannot be held flat physically.
+    """
     from sarcli.doppler.mapdrift import map_drift
     from sarcli.doppler.rangecomp import range_compress_valid
 
     radar = raw.radar
+    lam = radar.wavelength_m
     a0 = max(0, (raw.echo.shape[0] - max_lines) // 2)
     rc, valid = range_compress_valid(_central_lines(raw.echo, max_lines), radar, raw.replica)
     dr = C / (2.0 * radar.range_sampling_rate_hz)
     t_c = float(np.mean(raw.azimuth_time[a0:a0 + rc.shape[0]]))
     edges = np.linspace(0, rc.shape[1], max(1, n_seg) + 1).astype(int)
-    rng, frs, info = [], [], []
+    rng, frs, wts, segments = [], [], [], []
     for a, b in zip(edges[:-1], edges[1:], strict=True):
         if b - a < 8:
             continue
@@ -325,21 +337,32 @@ def _mapdrift(raw: RawProduct, fdc_poly: Poly2D, geo, Rg, T, v_guess: float, n_s
             fr0 = float(geo.fr_exact(r_seg, t_c, fdc))
         else:
             v = radar.platform_velocity_mps or v_guess
-            fr0 = -2.0 * v**2 / (radar.wavelength_m * r_seg)
-        res = map_drift(rc[:, a:b], radar.prf_hz, radar.wavelength_m, r_seg, dr, fdc, fr0)
+            fr0 = -2.0 * v**2 / (lam * r_seg)
+        res = map_drift(rc[:, a:b], radar.prf_hz, lam, r_seg, dr, fdc, fr0)
         ok = res.converged and res.fr_hz_per_s < 0 and abs(res.fr_hz_per_s / fr0 - 1.0) < 0.3
-        info.append({"range_m": r_seg, "fr_hz_per_s": res.fr_hz_per_s, "start_hz_per_s": fr0,
-                     "iterations": res.iterations, "converged": res.converged, "used": bool(ok)})
+        segments.append({"range_m": r_seg, "fr_hz_per_s": res.fr_hz_per_s, "start_hz_per_s": fr0,
+                         "iterations": res.iterations, "converged": res.converged, "used": bool(ok)})
         if ok:  # a segment without focusable content (noise, dark sea) does not converge: dropped
             rng.append(r_seg)
             frs.append(res.fr_hz_per_s)
+            wts.append(float(b - a))
     if not frs:
         raise SarcliError("map-drift did not converge in any range segment (no focusable scene content?); "
                           "give the Doppler rate another way (--fr-method orbit needs state vectors)")
-    # fr = -2 V^2/(lam R): fit fr*R (~ -2 V^2/lam) linearly in R over the segments, then sample it over
-    # the model grid (whole swath + margin), so the polynomial's domain covers the swath
-    rr, ff = np.array(rng), np.array(frs)
-    k = np.polyfit(rr, ff * rr, 1 if rr.size > 1 else 0)
+    rr, ff, ww = np.array(rng), np.array(frs), np.array(wts)
+    swr = np.sum(ww / rr**2)
+    c = float(np.sum(ww * ff / rr) / swr)
+    vr = float(np.sqrt(-c * lam / 2.0))
+    sigma_v = None
+    if rr.size > 1:
+        s2 = np.sum(ww * (ff - c / rr) ** 2) / (rr.size - 1)
+        sigma_v = float(lam * np.sqrt(s2 / swr) / (4.0 * vr))
+    for seg in segments:
+        seg["model_hz_per_s"] = c / seg["range_m"]
     GR, GT = _model_grid(raw)
-    poly, _ = fit_poly2d(GR, GT, np.polyval(k, GR) / GR, np.ones_like(GR), (3, 0), k_sigma=np.inf)
+    x0, xs = 0.5 * (GR.min() + GR.max()), 0.5 * (GR.max() - GR.min())
+    y0, ys = 0.5 * (GT.min() + GT.max()), max(0.5 * (GT.max() - GT.min()), 1e-12)
+    poly = Poly2D(np.array([[c]]), x0, xs, y0, ys, x_power=-1)
+    info = {"velocity_mps": vr, "velocity_sigma_mps": sigma_v, "n_segments_used": int(rr.size),
+            "segments": segments}
     return poly, poly(Rg, T), info

@@ -3,8 +3,10 @@
 ``DopplerModel.fdc(range_m, azimuth_time_s)`` is the ABSOLUTE Doppler centroid (Hz, ambiguity
 included) and ``DopplerModel.fr(range_m, azimuth_time_s)`` the Doppler rate (Hz/s, negative for a
 side-looking radar), both vectorized float64 over broadcastable arrays of slant range (m) and azimuth
-time (s after the product epoch). Both are 2-D polynomials fitted to the per-block estimates; the
-per-block tables, methods and parameters travel with the model (and in ``doppler.h5``).
+time (s after the product epoch). Both are 2-D polynomials fitted to the per-block estimates (the
+map-drift rate is the effective-velocity law -2 Vr^2/(lam R), a ``Poly2D`` with ``x_power = -1``, valid
+at every range); the per-block tables, methods and parameters travel with the model (and in
+``doppler.h5``).
 """
 
 from __future__ import annotations

@@ -3,7 +3,9 @@
 x, y are normalized coordinates (``Poly2D`` stores the offsets and scales, so evaluation takes physical
 range in m and azimuth time in s). Outside the fitted domain the polynomial is held constant at the
 domain edge (coordinates are clipped): a cubic extrapolated a few swath widths away swings by hundreds
-of Hz, a clipped one cannot. Outliers: after a weighted least-squares fit, blocks whose residual
+of Hz, a clipped one cannot. A physical range law multiplies the polynomial by x^p (``x_power``, the
+unclipped physical range): the effective-velocity Doppler rate fr = -2 Vr^2/(lam R) is the constant
+c = -2 Vr^2/lam times R^-1, valid at every range. Outliers: after a weighted least-squares fit, blocks whose residual
 exceeds ``k_sigma`` robust standard deviations (1.4826 * weighted MAD, floored at ``floor``) are
 flagged and the fit is repeated without them, until no new block is flagged. Flagged blocks are kept in
 the tables (with their flag), never silently used.
@@ -26,14 +28,16 @@ def poly2d_design(x: np.ndarray, y: np.ndarray, degree: tuple[int, int]) -> np.n
 
 @dataclass
 class Poly2D:
-    """z = sum c[i, j] u^i v^j with u = (x - x0)/xs, v = (y - y0)/ys, |u|, |v| clipped to 1 (the fitted
-    domain is x0 +- xs, y0 +- ys). Units of z as fitted."""
+    """z = x^p sum c[i, j] u^i v^j with u = (x - x0)/xs, v = (y - y0)/ys, |u|, |v| clipped to 1 (the
+    fitted domain is x0 +- xs, y0 +- ys), p = ``x_power`` applied to the physical, unclipped x (0: a
+    plain polynomial). Units of z as fitted."""
 
     coef: np.ndarray  # (dx+1, dy+1)
     x0: float
     xs: float
     y0: float
     ys: float
+    x_power: int = 0
 
     def __call__(self, x, y) -> np.ndarray:
         u = np.clip((np.asarray(x, float) - self.x0) / self.xs, -1.0, 1.0)
@@ -43,6 +47,8 @@ class Poly2D:
         for i in range(self.coef.shape[0]):
             for j in range(self.coef.shape[1]):
                 out = out + self.coef[i, j] * u**i * v**j
+        if self.x_power:
+            out = out * np.asarray(x, float) ** self.x_power
         return out
 
 

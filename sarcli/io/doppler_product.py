@@ -11,7 +11,8 @@ Layout (SI units)::
                       fr_hz_per_s, fr_seed_hz_per_s, look_seed_rad, range_seed_m, outlier
     /fdc_poly         coef (dx+1, dy+1) Hz; attributes x0, xs (m), y0, ys (s):
                       fdc(R, t) = sum coef[i, j] ((R - x0)/xs)^i ((t - y0)/ys)^j   (absolute centroid)
-    /fr_poly          the same for the Doppler rate (Hz/s)
+    /fr_poly          the same for the Doppler rate (Hz/s); an attribute x_power = p (default 0) multiplies
+                      it by R^p (map-drift: p = -1, one coefficient -2 Vr^2/lam, fr = -2 Vr^2/(lam R))
 
 ``read_doppler(path)`` returns the :class:`sarcli.doppler.model.DopplerModel` (contract 4).
 """
@@ -43,6 +44,7 @@ def _write_poly(f, name: str, p: Poly2D, units: str) -> None:
             description="sum coef[i,j] ((range - x0)/xs)^i ((time - y0)/ys)^j")
     for k in ("x0", "xs", "y0", "ys"):
         g.attrs[k] = float(getattr(p, k))
+    g.attrs["x_power"] = int(p.x_power)
 
 
 def _read_poly(f, name: str, path) -> Poly2D:
@@ -51,7 +53,7 @@ def _read_poly(f, name: str, path) -> Poly2D:
     g = f[name]
     coef = require(g, "coef", path, shape_rank=2)[()]
     try:
-        return Poly2D(coef, *(float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys")))
+        return Poly2D(coef, *(float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys")), int(g.attrs.get("x_power", 0)))
     except KeyError as e:
         raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
 
