@@ -31,8 +31,32 @@ def _overrides(start, stop, points, ifbw, power, data_format, pol, switch, rail_
     }
 
 
+def _resume_command(ctx: typer.Context, target: Path) -> str:
+    """The ``sarcli gbsar scan`` command line that continues ``target``: the options given to this
+    invocation (ports, config, overrides), with -o/--resume replaced by ``--resume target``."""
+    import shlex
+
+    parts = ["sarcli", "gbsar", "scan"]
+    for p in ctx.command.params:
+        v = ctx.params.get(p.name)
+        if p.name in ("output", "resume", "dry_run") or v is None or v is False or v == p.default:
+            continue
+        flag = max((o for o in p.opts if o.startswith("--")), key=len)
+        parts += [flag] if v is True else [flag, str(v)]
+    return shlex.join([*parts, "--resume", str(target)])
+
+
+def _series_resume_command(port: str, rail_port: str, config: Path, target: str) -> str:
+    """The ``sarcli gbsar scan`` command line that continues scan ``target`` of a repeat series."""
+    import shlex
+
+    return shlex.join(["sarcli", "gbsar", "scan", "--port", port, "--rail-port", rail_port, "--config", str(config),
+                       "--resume", str(target)])
+
+
 @gbsar_app.command("scan")
 def scan_cmd(
+    ctx: typer.Context,
     port: str = typer.Option(None, "--port", help="VNA serial port (Prologix GPIB-USB), e.g. /dev/ttyUSB0."),
     rail_port: str = typer.Option(None, "--rail-port", help="GRBL rail serial port, e.g. /dev/ttyACM0."),
     config: Path = typer.Option(None, "--config", "-c", help="Acquisition TOML (see samples/scan.toml)."),
@@ -109,7 +133,7 @@ def scan_cmd(
     if json_out:
         emit_json(summary)
     if summary["status"] != "complete":
-        raise failure(summary)
+        raise failure(summary, _resume_command(ctx, target))
     info(f"wrote {target}: {summary['n_complete']} stops, {summary['elapsed_s']:.1f} s, "
          f"{summary['retries']} retries")
 
@@ -194,6 +218,7 @@ def repeat_cmd(
 
     Examples:
 
+    \b
       sarcli gbsar repeat --every 30m --count 9 --port /dev/ttyUSB0 --rail-port /dev/ttyACM0 \\
           -c samples/scan.toml -o 'series/scan_{index:02d}_{utc}.h5'
     """
@@ -236,7 +261,9 @@ def repeat_cmd(
     if json_out:
         emit_json(summaries)
     if guard.requested:
-        raise failure(summaries[-1]) if summaries and "n_complete" in summaries[-1] else SarcliError(
+        last = summaries[-1] if summaries else {}
+        raise failure(last, _series_resume_command(port, rail_port, config, last["output"])) \
+            if "n_complete" in last else SarcliError(
             "interrupted", exit_code=130)
     if failed:
         raise SarcliError(f"{failed} of {count} scans did not complete (see above)")

@@ -158,9 +158,9 @@ def validate(cfg: ScanConfig, max_frequency_hz: float | None = None, max_travel_
     v, r, p = cfg.vna, cfg.rail, cfg.pol
     fmax = min(v.max_frequency_hz, max_frequency_hz or math.inf)
     if not (vna.MIN_FREQUENCY_HZ <= v.start_hz < v.stop_hz <= fmax):
-        raise ConfigError(f"frequency range {v.start_hz / 1e9:g}-{v.stop_hz / 1e9:g} GHz is outside "
-                          f"the 8753ES range {vna.MIN_FREQUENCY_HZ / 1e9:g}-{fmax / 1e9:g} GHz "
-                          "(or start >= stop)")
+        raise ConfigError(f"frequency range {format_frequency(v.start_hz)}-{format_frequency(v.stop_hz)} is "
+                          f"outside the 8753ES range {format_frequency(vna.MIN_FREQUENCY_HZ)}-"
+                          f"{format_frequency(fmax)} (or start >= stop)")
     if v.points not in vna.ALLOWED_POINTS:
         raise ConfigError(f"points = {v.points} is not allowed; choose one of "
                           f"{', '.join(map(str, vna.ALLOWED_POINTS))}")
@@ -257,6 +257,14 @@ def _quantity(text: str, units: dict[str, float], what: str) -> float:
 def parse_frequency(text: str) -> float:
     """'5.2GHz', '5200MHz' or '5.2e9' -> Hz."""
     return _quantity(text, _FREQ_UNITS, "frequency")
+
+
+def format_frequency(hz: float) -> str:
+    """30e3 -> '30 kHz', 6e9 -> '6 GHz', 5.2e9 -> '5.2 GHz' (largest unit with a value >= 1)."""
+    for unit, scale in (("GHz", 1e9), ("MHz", 1e6), ("kHz", 1e3)):
+        if abs(hz) >= scale:
+            return f"{hz / scale:g} {unit}"
+    return f"{hz:g} Hz"
 
 
 def parse_duration(text: str) -> float:

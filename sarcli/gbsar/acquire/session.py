@@ -96,9 +96,12 @@ def acquire(cfg: ScanConfig, vna_port: str, rail_port: str, output: str | os.Pat
     return summary
 
 
-def failure(summary: dict[str, Any]) -> SarcliError:
-    """The one-line error for an acquisition that ended early (file kept, --resume hint)."""
+def failure(summary: dict[str, Any], resume_command: str | None = None) -> SarcliError:
+    """The one-line error for an acquisition that ended early (file kept, --resume hint).
+
+    ``resume_command``: the full command line that continues the scan (the caller knows its options).
+    """
     n, total, out = summary["n_complete"], summary["n_planned"], summary["output"]
-    return SarcliError(f"{summary['error']}; {out} keeps {n} of {total} stops; "
-                       f"continue with: sarcli gbsar scan ... --resume {out}",
+    hint = resume_command or f"sarcli gbsar scan --port VNA_PORT --rail-port RAIL_PORT -c CONFIG --resume {out}"
+    return SarcliError(f"{summary['error']}; {out} keeps {n} of {total} stops; continue with: {hint}",
                        exit_code=summary["exit_code"] or InstrumentError.exit_code)
