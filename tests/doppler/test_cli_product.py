@@ -96,3 +96,11 @@ def test_cli_on_the_real_vancouver_block(cli, shared_data, tmp_path):
     lam = 2.9979e8 / 5.3e9
     fr_pub = -2 * 7062.0**2 / (lam * d["scene_range_m"])
     assert d["fr_hz_per_s"] == pytest.approx(fr_pub, rel=0.01)
+    # one effective velocity for the swath: |fr| falls as 1/R from near to far range (a free slope over
+    # the four map-drift segments had the wrong sign here), Vr reported with its uncertainty
+    md = d["fr_info"]["mapdrift"]
+    assert md["velocity_mps"] == pytest.approx(7062.0, rel=0.01) and 0 < md["velocity_sigma_mps"] < 70.0
+    r_b = np.array([b["range_m"] for b in d["blocks"]])
+    fr_b = np.array([b["fr_hz_per_s"] for b in d["blocks"]])
+    np.testing.assert_allclose(fr_b * r_b, -2 * md["velocity_mps"] ** 2 / lam, rtol=1e-4)
+    assert np.ptp(r_b) > 8e3 and np.all(np.diff(np.abs(fr_b)[np.argsort(r_b)]) < 0)
