@@ -223,17 +223,26 @@ def interpolate_cmd(
     if sv.frame == "ECEF":
         cols["lat_deg"], cols["lon_deg"], cols["h_m"] = ecef_to_geodetic(p)
     N = sv.default_n_nodes() if n_nodes is None else n_nodes
+    t0, t1 = sv.span
+    outside = np.flatnonzero((t < t0) | (t > t1))
+    if outside.size:
+        shown = ", ".join(f"{x:.6f}" for x in t[outside[:8]]) + (", ..." if outside.size > 8 else "")
+        info(f"warning: extrapolated {outside.size} of {t.size} time(s) beyond the state-vector span "
+             f"[{t0:.6f}, {t1:.6f}] s: {shown}")
     if csv is not None:
         _write_csv(csv, cols)
-        info(f"wrote {csv} ({t.size} rows)")
     if as_json:
         emit_json({"path": str(raw_path), "frame": sv.frame, "epoch_utc": raw.epoch_utc, "n_nodes": N,
+                   "span_s": [t0, t1], "extrapolated_time_s": t[outside].tolist(),
                    "utc": [add_seconds(raw.epoch_utc, x) for x in t[:10000]] if t.size <= 10000 else None,
                    **{k: c.tolist() for k, c in cols.items()}})
         return
+    if csv is not None:  # the table is in the file: one summary line, not the rows again
+        info(f"wrote {csv}: {t.size} row(s), {sv.frame}, Hermite N = {N}, t {t.min():.6f}..{t.max():.6f} s, "
+             f"columns {', '.join(cols)}")
+        return
     info(f"{sv.frame}, Hermite N = {N}, {t.size} time(s)")
-    head = ["time_s", "x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"] + (["lat_deg", "lon_deg", "h_m"]
-                                                                          if "lat_deg" in cols else [])
+    head = list(cols)
     info(" ".join(f"{h:>16}" for h in head))
     for i in range(min(t.size, 1000)):
         info(" ".join(f"{cols[h][i]:16.6f}" for h in head))
