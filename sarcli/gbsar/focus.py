@@ -178,6 +178,9 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
         "df_min_range_m": split, "criterion_rad": opts.criterion_rad,
         "near_algorithm": opts.near if opts.algorithm == "auto" else None,
         "rail_uniform": bool(uniform), "skipped_stops": prof0.skipped,
+        # L_x of the beam footprint |x - x_i| <= lam R0/(2 L_x) that limits each pixel's aperture
+        # (None: whole rail); interferometry masks pixels outside it (sarcli.gbsar.interferometry.support)
+        "footprint_antenna_length_m": lx if opts.beam_limited else None,
         "n_xfft": n_xfft_used, "seconds": timings, "polarizations": list(pols),
         "range_window": opts.range_window, "azimuth_window": opts.azimuth_window,
     }

@@ -18,6 +18,16 @@ The model phase of a flat surface at ``z_ref`` is removed and the residual conve
 LOS displacement ``-residual lam/(4 pi)`` (mm, + = away from the radar); cross-track and combined
 -> height ``z_ref + residual/(dphi/dh)``; delta-f -> range offset ``-residual c/(4 pi df)`` from the pixel
 range (delta-f measures range, not height; ambiguity c/(2 df)).
+
+Masking: a pixel is defined only where both images have support (:func:`support`: covered by the
+focusing algorithm, non-zero, inside the beam footprint of some rail stop); elsewhere phase, coherence,
+residual and value are NaN (an unsupported pixel is 0 in the image, and ``angle(+-0 +- 0j)`` is 0 or
++-pi by the signs of the zeros: bands of half-ambiguity "heights"). The converted value is also NaN where
+the coherence is below ``min_coherence`` (default 0.5). The default sits above the bias of the boxcar
+estimator on pixels with no correlation at all (``E|gamma| ~ sqrt(pi/(4 L))`` for L independent looks:
+0.18 for 25 looks, ~0.3 for the ~9 independent looks of an oversampled 5 x 5 window) and keeps pixels whose
+phase standard deviation ``sqrt((1 - g^2)/(2 L g^2))`` (Cramer-Rao) is <= 14 deg at L = 25 (0.37 m of height
+at 100 m for Bv = 0.3 m, 1.1 mm of LOS displacement).
 """
 
 from __future__ import annotations
@@ -34,10 +44,8 @@ from sarcli.io.gbsar_image import GbsarImage
 MODES = ("dinsar", "crosstrack", "deltaf", "combined")
 
 
-def check_compatible(a: GbsarImage, b: GbsarImage, mode: str, pol: str) -> None:
-    """One-line errors for images that cannot be combined in ``mode``."""
-    if mode not in MODES:
-        raise SarcliError(f"unknown interferometric mode '{mode}' (use {', '.join(MODES)})")
+def check_same_grid(a: GbsarImage, b: GbsarImage, pol: str) -> None:
+    """One-line errors for images whose frequency grid, pixel grid or polarizations differ."""
     if a.n_freq != b.n_freq or not np.isclose(a.frequency_step_hz, b.frequency_step_hz, rtol=1e-9):
         raise SarcliError(f"the scans have different frequency grids ({a.n_freq} x {a.frequency_step_hz:g} Hz vs "
                           f"{b.n_freq} x {b.frequency_step_hz:g} Hz): their range pixels differ")
@@ -46,6 +54,13 @@ def check_compatible(a: GbsarImage, b: GbsarImage, mode: str, pol: str) -> None:
         raise SarcliError("the images are on different grids; focus both with the same --max-range/--pixel-x/--width")
     for img in (a, b):
         img.pol(pol)
+
+
+def check_compatible(a: GbsarImage, b: GbsarImage, mode: str, pol: str) -> None:
+    """One-line errors for images that cannot be combined in ``mode``."""
+    if mode not in MODES:
+        raise SarcliError(f"unknown interferometric mode '{mode}' (use {', '.join(MODES)})")
+    check_same_grid(a, b, pol)
     df = b.center_frequency_hz - a.center_frequency_hz
     bv = b.rail_height_m - a.rail_height_m
     if mode in ("dinsar", "crosstrack") and abs(df) > 1e-3:
@@ -70,6 +85,23 @@ def coherence(a: np.ndarray, b: np.ndarray, window: int) -> np.ndarray:
         return np.where(pa * pb > 0, num / np.sqrt(pa * pb), 0.0).astype(np.float32)
 
 
+def support(img: GbsarImage, pol: str) -> np.ndarray:
+    """(n_r, n_x) bool: pixels the image has data for.
+
+    Covered by its algorithm (``algorithm_map != 0``), non-zero, and -- when the product records the
+    footprint's L_x (``report["footprint_antenna_length_m"]``) -- seen by some rail stop: the pixel's
+    synthetic aperture, the rail ``[x_c - X/2, x_c + X/2]`` intersected with the beam footprint
+    ``|x - x_i| <= lam R0/(2 L_x)`` (seed 000 Fig. 2, as in BP and DF), is not empty. RD leaks energy
+    outside the footprint (non-zero there), so the geometric test is needed beside the zero test.
+    """
+    ok = (img.algorithm_map != 0) & (img.pol(pol) != 0)
+    lx = img.report.get("footprint_antenna_length_m")
+    if lx:
+        off_rail = np.maximum(np.abs(img.azimuth_m - img.rail_centre_m) - img.rail_length_m / 2, 0.0)
+        ok &= off_rail[None, :] <= img.wavelength_m * img.range_m[:, None] / (2 * lx)
+    return ok
+
+
 def surface_ranges(r0_a: np.ndarray, h_a: float, h_b: float, z_ref: float) -> np.ndarray:
     """Range from B's rail of the surface point (height z_ref) seen at range r0_a from A's rail (NaN if none)."""
     with np.errstate(invalid="ignore"):
@@ -87,16 +119,21 @@ class Interferogram:
     value_name: str
     value_unit: str
     rate: dict
+    support: np.ndarray  # bool, both images have data (phase, coherence, residual NaN elsewhere)
 
 
 def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5,
-              z_ref_m: float = 0.0) -> Interferogram:
-    """Interferogram of B against A in ``mode`` (see the module docstring)."""
+              z_ref_m: float = 0.0, min_coherence: float = 0.5) -> Interferogram:
+    """Interferogram of B against A in ``mode`` (see the module docstring); the value is NaN outside
+    the common support and where the coherence is below ``min_coherence`` (0 keeps every supported pixel)."""
+    if not 0.0 <= min_coherence <= 1.0:
+        raise SarcliError(f"the minimum coherence must be in [0, 1], not {min_coherence:g}")
     check_compatible(a, b, mode, pol)
     ia, ib = a.pol(pol), b.pol(pol)
+    ok = support(a, pol) & support(b, pol)
     z = ib * np.conj(ia)
-    phase = np.angle(z).astype(np.float32)
-    coh = coherence(ia, ib, window)
+    phase = np.where(ok, np.angle(z), np.nan).astype(np.float32)
+    coh = np.where(ok, coherence(ia, ib, window), np.nan).astype(np.float32)
     fa, fb = a.center_frequency_hz, b.center_frequency_hz
     r0 = a.range_m[:, None] * np.ones((1, a.azimuth_m.size))
     rb = surface_ranges(r0, a.rail_height_m, b.rail_height_m, z_ref_m)
@@ -108,7 +145,7 @@ def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5
     else:  # crosstrack (fa == fb) and combined
         model = -4 * np.pi * (fb * rb - fa * r0) / C_LIGHT
     resid = np.angle(z * np.exp(-1j * np.nan_to_num(model))).astype(np.float32)
-    resid[~np.isfinite(model)] = np.nan
+    resid[~(np.isfinite(model) & ok)] = np.nan
     lam_a, lam_b = C_LIGHT / fa, C_LIGHT / fb
     if mode == "dinsar":
         value, name, unit = -resid * lam_a / (4 * np.pi) * 1e3, "los_displacement", "mm"
@@ -124,6 +161,7 @@ def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5
         rate = {"deg_per_m_height_at_100m": np.degrees(4 * np.pi * bv / (lam_b * 100.0)),
                 "height_ambiguity_at_100m_m": abs(lam_b * 100.0 / (2 * bv))}
     rate.update({"vertical_baseline_m": bv, "delta_f_hz": dfreq})
+    with np.errstate(invalid="ignore"):
+        value = np.where(coh >= min_coherence, value, np.nan).astype(np.float32)  # NaN coherence fails too
     return Interferogram(phase=phase, coherence=coh, model_phase=np.nan_to_num(model).astype(np.float32),
-                         residual=resid, value=np.asarray(value, np.float32), value_name=name, value_unit=unit,
-                         rate=rate)
+                         residual=resid, value=value, value_name=name, value_unit=unit, rate=rate, support=ok)

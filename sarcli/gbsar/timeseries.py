@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from sarcli.errors import SarcliError
+from sarcli.gbsar.interferometry import check_same_grid
 
 
 def temporal_coherence(stack: np.ndarray) -> np.ndarray:
@@ -41,3 +42,20 @@ def ps_series(stack: np.ndarray, rows: np.ndarray, cols: np.ndarray, wavelength_
     z = stack[:, rows, cols].T  # (n_ps, N)
     ph = np.unwrap(np.angle(z * np.conj(z[:, :1])), axis=1)
     return ph.astype(np.float32), (-ph * wavelength_m / (4 * np.pi) * 1e3).astype(np.float32)
+
+
+def check_series(images: list, pol: str, names: list[str]) -> None:
+    """One-line errors for images that cannot form a PS series: every image must share the first one's
+    frequency grid, pixel grid and polarization (``check_same_grid``) and its geometry -- rail height and
+    centre frequency -- since a PS series is repeat-pass, zero-baseline DInSAR (a different rail height
+    or frequency adds the cross-track or delta-f phase to every pixel and breaks the temporal coherence)."""
+    ref = images[0]
+    for img, name in zip(images[1:], names[1:], strict=True):
+        check_same_grid(ref, img, pol)
+        bv = img.rail_height_m - ref.rail_height_m
+        df = img.center_frequency_hz - ref.center_frequency_hz
+        if abs(bv) > 1e-6 or abs(df) > 1e-3:
+            what = f"a rail height {bv:+g} m" if abs(bv) > 1e-6 else f"a centre frequency {df:+g} Hz"
+            raise SarcliError(f"{name} has {what} off {names[0]}: a PS series needs scans of one geometry "
+                              f"(interfere that pair with --mode {'crosstrack' if abs(bv) > 1e-6 else 'deltaf'} "
+                              "or combined instead)")

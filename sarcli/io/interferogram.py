@@ -7,7 +7,10 @@
     /coherence        float32, boxcar sample coherence (window in the attributes)
     /model_phase      float32 rad, flat-surface model phase of the mode
     /residual_phase   float32 rad, wrapped phase after removing the model (NaN where undefined)
-    /value            float32, converted residual: LOS displacement (mm) | height (m) | range offset (m)
+    /value            float32, converted residual: LOS displacement (mm) | height (m) | range offset (m),
+                      NaN where the coherence is below the ``min_coherence`` attribute
+    phase, coherence, residual_phase and value are NaN outside the common support of the two images
+    (outside the beam footprint or not covered by the focusing algorithm).
     /range, /azimuth  float64 axes (m), as the input images
 
 ``gbsar_ps`` (schema 1), temporal coherence and persistent scatterers::

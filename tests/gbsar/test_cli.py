@@ -114,13 +114,29 @@ def test_interfere_dinsar_and_mismatch(cli, tmp_path):
     a = _scan(cli, tmp_path, "a")
     b = _scan(cli, tmp_path, "b", minute=30, extra="[effects.displacement]\nscale = 1.0\n")
     out, png, tif = tmp_path / "ifg.h5", tmp_path / "ifg.png", tmp_path / "ifg.tif"
-    r = cli("gbsar", "interfere", a, b, "--mode", "dinsar", "-o", out, "--png", png, "--geotiff", tif, "--json")
+    vtif = tmp_path / "los.tif"
+    r = cli("gbsar", "interfere", a, b, "--mode", "dinsar", "-o", out, "--png", png, "--geotiff", tif,
+            "--value-geotiff", vtif, "--json")
     assert r.exit_code == 0, r.stderr
-    assert json.loads(r.stdout)["rate"]["deg_per_m_los"] == pytest.approx(-12729, rel=0.001)
+    s = json.loads(r.stdout)
+    assert s["rate"]["deg_per_m_los"] == pytest.approx(-12729, rel=0.001) and s["min_coherence"] == 0.5
     d = read_interferogram(out)
     i = int(np.argmin(abs(d["range"] - np.hypot(30.0, 2.0))))
     j = int(np.argmin(abs(d["azimuth"])))
     assert d["value"][i, j] == pytest.approx(1.0, abs=0.1)  # the 1 mm LOS displacement
+    # outside the beam footprint |x| - X/2 > lam R0/(2 L_x) (default L_x 0.25 m, rail 1 m): NaN, not phase 0
+    outside = np.abs(d["azimuth"])[None, :] - 0.5 > 299792458.0 / 5.3e9 * d["range"][:, None] / 0.5 + 1e-6
+    assert outside.sum() > 100 and np.all(np.isnan(d["value"][outside])) and np.all(np.isnan(d["phase"][outside]))
+    inner = (d["range"][:, None] > 3.0) & (d["range"][:, None] < d["range"][-1])  # DF does not cover R_max itself
+    assert np.all(np.isfinite(d["phase"][~outside & inner]))
+    assert s["supported_pixels"] == int(np.count_nonzero(np.isfinite(d["phase"])))
+    import rasterio
+
+    with rasterio.open(vtif) as ds:
+        v = ds.read(1)
+        # nodata outside; inside, a wrapped phase gives at most lam/4 of LOS displacement (14.1 mm)
+        assert np.isnan(ds.nodata) and np.isnan(v).any() and np.isfinite(v).any()
+        assert np.nanmax(np.abs(v)) <= 299792458.0 / 5.3e9 / 4 * 1e3
     assert png.stat().st_size > 1000 and tif.stat().st_size > 0
     other = tmp_path / "c.toml"
     other.write_text(SCENE.format(seed=1, minute=0, extra="").replace("points = 201", "points = 101"))
@@ -144,6 +160,14 @@ def test_coherence_ps_series_and_polarimetry(cli, tmp_path):
     rows = list(csv.reader(csv_path.open()))
     assert rows[0][:4] == ["ps", "azimuth_m", "range_m", "coherence"] and len(rows) == s["n_ps"] + 1
     assert plot.stat().st_size > 1000
+    r = cli("gbsar", "coherence", scans[0], scans[0], "-o", tmp_path / "same.h5", "--plot", tmp_path / "s.png",
+            "--json")  # identical epochs: one warning line, the plot falls back to the scan index
+    assert r.exit_code == 0 and json.loads(r.stdout)["plot_time_axis"] == "scan_index"
+    assert r.stderr.count("warning:") == 1 and "scan index" in r.stderr
+    high = _scan(cli, tmp_path, "high", seed=4, minute=40, extra="[effects.vertical_baseline]\noffset_m = 0.3\n")
+    r = cli("gbsar", "coherence", scans[0], high, "-o", tmp_path / "bad.h5")
+    assert r.exit_code != 0 and "Traceback" not in r.stderr
+    assert "one geometry" in r.stderr and "interfere that pair with --mode crosstrack" in r.stderr
     r = cli("gbsar", "polarimetry", scans[0], "--png", tmp_path / "nd.png", "--json")
     assert r.exit_code == 0, r.stderr
     assert -1.0 <= json.loads(r.stdout)["mean"] <= 1.0
@@ -173,3 +197,25 @@ def test_products_are_reproducible(cli, tmp_path, monkeypatch):
         assert cli("gbsar", "focus", tmp_path / d / "s.h5", "-o", tmp_path / d / "i.h5").exit_code == 0
         blobs.append(((tmp_path / d / "s.h5").read_bytes(), (tmp_path / d / "i.h5").read_bytes()))
     assert blobs[0] == blobs[1]
+
+
+def test_readme_examples_are_self_contained():
+    """Every input of an example in the README section is a shipped sample or made by an earlier line."""
+    import re
+    import shlex
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "docs/readme/60-gbsar.md").read_text()
+    made: set[str] = set()
+    lines = [ln.split("#")[0].strip() for ln in re.findall(r"```sh\n(.*?)```", text, re.S)[0].splitlines()]
+    assert sum(ln.startswith("sarcli gbsar") for ln in lines) >= 10
+    for ln in filter(None, lines):
+        words = shlex.split(ln)
+        outs = {w for k, w in enumerate(words[1:], 1) if words[k - 1].startswith("-")}
+        for w in words[3:]:
+            if w.endswith(".toml"):
+                assert (root / w).is_file(), (ln, w)
+            elif w.endswith(".h5") and w not in outs:
+                assert w in made, (ln, w)
+        made |= {w for w in outs if w.endswith(".h5")}

@@ -144,3 +144,74 @@ def test_polarimetric_normalized_difference():
     img = image_from_scan(s, BP, Grid(ranges=np.array([40.0]), azimuths=np.array([-5.0, 0.0, 5.0])))
     nd = normalized_difference(img.pol("HH"), img.pol("VV"))
     np.testing.assert_allclose(nd[0], [1.0, 0.0, -1.0], atol=0.01)
+
+
+def _synthetic(image, alg_map=None, report=None, **kw):
+    """A one-polarization GbsarImage on a 1 m grid (ranges 40.., azimuths centred on the rail)."""
+    from sarcli.io.gbsar_image import GbsarImage
+
+    n_r, n_x = image.shape
+    d = dict(image=image[None].astype(np.complex64), range_m=40.0 + np.arange(n_r, dtype=float),
+             azimuth_m=np.arange(n_x, dtype=float) - n_x // 2, polarizations=("VV",), algorithm="bp",
+             algorithm_map=np.full((n_r, n_x), 3, np.uint8) if alg_map is None else alg_map,
+             center_frequency_hz=5.3e9, frequency_step_hz=5e5, n_freq=401, rail_height_m=H, rail_centre_m=0.0,
+             rail_length_m=5.0, epoch_utc="2007-05-10T02:00:00Z", scan_time_s=0.0, report=report or {})
+    d.update(kw)
+    return GbsarImage(**d)
+
+
+def test_value_masked_below_min_coherence_and_kept_on_coherent_pixels():
+    """DInSAR value -phi lam/(4 pi) where the 5x5 coherence is 1; NaN where the phase is random."""
+    rng = np.random.default_rng(3)
+    n_r, n_x = 30, 40
+    phi = np.full((n_r, n_x), -0.4)  # -0.4 rad = +0.180 mm LOS (theory: d = -phi lam / (4 pi))
+    phi[:, 20:] = rng.uniform(-np.pi, np.pi, (n_r, 20))  # decorrelated half
+    a = _synthetic(np.ones((n_r, n_x)))
+    b = _synthetic(np.exp(1j * phi))
+    ifg = interfere(a, b, "dinsar", "VV", window=5, min_coherence=0.5)
+    lam = 299792458.0 / 5.3e9
+    np.testing.assert_allclose(ifg.value[:, :17], 0.4 * lam / (4 * np.pi) * 1e3, rtol=1e-5)
+    assert np.all(ifg.coherence[:, :17] > 0.999)
+    assert np.all(np.isnan(ifg.value[:, 23:])) and np.all(ifg.coherence[:, 23:] < 0.5)
+    assert np.all(np.isfinite(ifg.phase)) and np.all(np.isfinite(ifg.residual))  # only the value is thresholded
+    kept = interfere(a, b, "dinsar", "VV", window=5, min_coherence=0.0)
+    assert np.all(np.isfinite(kept.value))
+    with pytest.raises(SarcliError, match="minimum coherence"):
+        interfere(a, b, "dinsar", "VV", min_coherence=1.5)
+
+
+def test_signed_zeros_outside_support_are_nan_not_pi():
+    """Unsupported pixels hold +-0: angle() would give 0 or +-pi (bands of half-ambiguity heights)."""
+    img = np.ones((10, 12), np.complex64)
+    img[:, :3] = np.complex64(complex(-0.0, 0.0))  # DF: interpolated value times a zero aperture gain
+    amap = np.full((10, 12), 1, np.uint8)
+    amap[:, -2:] = 0  # not covered by the algorithm (non-zero leftovers must not count)
+    a = _synthetic(img, amap)
+    b = _synthetic(img * np.complex64(np.exp(0.3j)), amap, rail_height_m=H - 0.3)
+    ifg = interfere(a, b, "crosstrack", "VV", window=1, min_coherence=0.0)
+    for arr in (ifg.phase, ifg.coherence, ifg.residual, ifg.value):
+        assert np.all(np.isnan(arr[:, :3])) and np.all(np.isnan(arr[:, -2:]))
+        assert np.all(np.isfinite(arr[:, 3:-2]))
+
+
+def test_pixels_outside_the_beam_footprint_are_nan_for_every_algorithm():
+    """BP images 0 outside the footprint, RD leaks energy there: both masked by the footprint geometry
+    |x| - X/2 > lam R0/(2 L_x) (seed 000 Fig. 2); a bright target inside keeps its height."""
+    lx, lam = 0.25, 299792458.0 / 5.3e9
+    ant = {"length_azimuth_m": lx, "pattern": "sinc"}
+    pts = [_ground(0.0, 50.0, 2.0), _ground(-4.0, 50.0)]
+    grid = Grid(ranges=np.arange(46.0, 54.1, 1.0), azimuths=np.arange(-14.0, 14.1, 0.5))
+    outside = (np.abs(grid.azimuths)[None, :] - 2.5) > lam * grid.ranges[:, None] / (2 * lx) + 1e-9
+    assert outside.any() and (~outside).any()
+    eff = {"antenna_pattern": {}}
+    for alg in ("bp", "rd"):
+        opts = FocusOptions(algorithm=alg)
+        a = image_from_scan(_scan(pts, eff, antenna=ant), opts, grid)
+        b = image_from_scan(_scan(pts, {**eff, "vertical_baseline": {"offset_m": -0.3}}, seed=2, antenna=ant),
+                            opts, grid)
+        ifg = interfere(a, b, "crosstrack", "VV", window=1)
+        for arr in (ifg.phase, ifg.coherence, ifg.residual, ifg.value):
+            assert np.all(np.isnan(arr[outside])), alg
+        assert np.all(np.isfinite(ifg.phase[~outside])), alg
+        i, j = int(np.argmin(abs(grid.ranges - 50.0))), int(np.argmin(abs(grid.azimuths)))
+        assert ifg.value[i, j] == pytest.approx(2.0, abs=0.15), alg  # the 2 m high target keeps its height

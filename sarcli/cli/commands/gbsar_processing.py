@@ -265,8 +265,9 @@ def _image_outputs(img, geotiff, enu_geotiff, map_pixel, ground_height, quickloo
                         xlabel="azimuth x (m)", ylabel="range R0 (m)", aspect="auto")
 
 
-def _load_image(path: Path, algorithm: str = "auto", max_range: float | None = None):
-    """A focused image product, or a scan focused on the fly with ``algorithm`` (default grid)."""
+def _load_image(path: Path, like=None):
+    """A focused image product, or a scan focused on the fly with ``auto`` on the grid of the image
+    ``like`` (default grid without one: it depends on the wavelength, so a delta-f pair needs ``like``)."""
     from sarcli.io.h5common import attr_str, open_product
 
     with open_product(path, ("gbsar_image", "gbsar_scan")) as f:
@@ -275,10 +276,11 @@ def _load_image(path: Path, algorithm: str = "auto", max_range: float | None = N
         from sarcli.io.gbsar_image import read_gbsar_image
 
         return read_gbsar_image(path)
-    from sarcli.gbsar.focus import FocusOptions, image_from_scan
+    from sarcli.gbsar.focus import Grid, image_from_scan
     from sarcli.io.scan import read_scan
 
-    return image_from_scan(read_scan(path), FocusOptions(algorithm=algorithm, max_range_m=max_range))
+    grid = Grid(ranges=like.range_m, azimuths=like.azimuth_m) if like is not None else None
+    return image_from_scan(read_scan(path), grid=grid)
 
 
 def _map_outputs(raster, img, geotiff: Path | None, png: Path | None, title: str, label: str, cmap: str,
@@ -335,7 +337,8 @@ def interfere_cmd(
     """
     from sarcli.gbsar.interferometry import interfere
 
-    a, b = _load_image(reference), _load_image(secondary)
+    a = _load_image(reference)
+    b = _load_image(secondary, like=a)
     pol = (pol or a.polarizations[0]).upper()
     ifg = interfere(a, b, mode, pol, window, ground_height, min_coherence)
     attrs = {"mode": mode, "pol": pol, "coherence_window": window, "ground_height_m": ground_height,
@@ -393,7 +396,8 @@ def coherence_cmd(
 
     if len(images) < 2:
         raise SarcliError("coherence needs at least 2 images")
-    imgs = [_load_image(p) for p in images]
+    imgs = [_load_image(images[0])]
+    imgs += [_load_image(p, like=imgs[0]) for p in images[1:]]
     pol = (pol or imgs[0].polarizations[0]).upper()
     check_series(imgs, pol, [str(p) for p in images])
     stack = np.stack([im.pol(pol) for im in imgs])
