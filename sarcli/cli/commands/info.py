@@ -1,4 +1,4 @@
-"""``sarcli info``: summarize any sarcli product (raw in detail, every other type generically)."""
+"""``sarcli info``: summarize any sarcli product (raw, SLC and scan in detail, every type generically)."""
 
 from __future__ import annotations
 
@@ -93,6 +93,52 @@ def _raw_summary(f, summary: dict[str, Any]) -> None:
                         "orbit_stop_utc": None, "orbit_span_s": None})
 
 
+def _slc_summary(f, summary: dict[str, Any]) -> None:
+    """Shape, pixel spacings, algorithm, zero-Doppler time span and slant-range span of an SLC."""
+    a = summary["attributes"]
+    n_lines, n_samples = f["image"].shape
+    rng = f["slant_range"][()] if "slant_range" in f else None
+    span = _time_span(f, "azimuth_time", summary.get("epoch_utc")) if "azimuth_time" in f else {}
+    summary.update({
+        "main_dataset": "/image", "shape": [n_lines, n_samples], "n_lines": n_lines, "n_samples": n_samples,
+        "algorithm": a.get("algorithm"), "range_spacing_m": _num(a.get("range_spacing_m")),
+        "azimuth_spacing_m": _num(a.get("azimuth_spacing_m")), "prf_hz": _num(a.get("prf_hz")),
+        "first_full_line": _int(a.get("first_full_line")), "last_full_line": _int(a.get("last_full_line")),
+        "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
+        "azimuth_span_s": span.get("span_s"),
+        "first_range_m": float(rng[0]) if rng is not None and rng.size else None,
+        "last_range_m": float(rng[-1]) if rng is not None and rng.size else None,
+    })
+
+
+def _scan_summary(f, summary: dict[str, Any]) -> None:
+    """Polarizations, stops (complete of planned), frequency sweep, rail extent and status of a scan."""
+    a = summary["attributes"]
+    freq = f["frequency"][()] if "frequency" in f else None
+    x = f["rail_position"][()] if "rail_position" in f else None
+    pols = a.get("polarizations")
+    summary.update({
+        "main_dataset": "/s21", "polarizations": pols.split(",") if isinstance(pols, str) and pols else [],
+        "status": a.get("status"), "n_stops_complete": _int(a.get("n_complete")),
+        "n_stops_planned": _int(a.get("n_planned")),
+        "n_frequencies": int(freq.size) if freq is not None else 0,
+        "frequency_start_hz": float(freq.min()) if freq is not None and freq.size else None,
+        "frequency_stop_hz": float(freq.max()) if freq is not None and freq.size else None,
+        "frequency_step_hz": float((freq[-1] - freq[0]) / (freq.size - 1)) if freq is not None and freq.size > 1
+        else None,
+        "rail_start_m": float(x.min()) if x is not None and x.size else None,
+        "rail_stop_m": float(x.max()) if x is not None and x.size else None,
+    })
+
+
+def _num(v) -> float | None:
+    return None if v is None else float(v)
+
+
+def _int(v) -> int | None:
+    return None if v is None else int(v)
+
+
 def summarize(path: Path) -> dict[str, Any]:
     """A JSON-ready summary of any sarcli product (keys documented in docs/readme/20-ingest-info.md)."""
     from sarcli.io.h5common import PROVENANCE_ATTRS, open_product, provenance
@@ -115,6 +161,10 @@ def summarize(path: Path) -> dict[str, Any]:
         if prov["product_type"] == "raw" and "echo" in f:
             summary["main_dataset"] = "/echo"
             _raw_summary(f, summary)
+        elif prov["product_type"] == "slc" and "image" in f:
+            _slc_summary(f, summary)
+        elif prov["product_type"] == "gbsar_scan" and "s21" in f:
+            _scan_summary(f, summary)
     return summary
 
 
@@ -130,18 +180,50 @@ def _human(s: dict[str, Any]) -> None:
             f"PRF {s['prf_hz']:.3f} Hz")
         say(f"  range {s['first_range_m']:.2f} .. {s['last_range_m']:.2f} m, fs {s['range_sampling_rate_hz'] / 1e6:.6f}"
             f" MHz, wavelength {s['wavelength_m']:.6f} m, chirp {s['chirp_rate_hz_per_s']:.6g} Hz/s, "
-            f"pulse {s['pulse_length_s'] * 1e6:.3f} us, {s['quantization_bits']} bit")
+            f"pulse {s['pulse_length_s'] * 1e6:.3f} us, {_bits(s['quantization_bits'])}")
         if s["n_state_vectors"]:
             say(f"  orbit: {s['n_state_vectors']} state vectors ({s['orbit_frame']}), "
                 f"{s['orbit_start_utc']} .. {s['orbit_stop_utc']}")
         else:
             say("  orbit: none")
-    else:
-        for name, span in s["time_spans"].items():
-            if span:
-                say(f"  {name}: {span['start_utc']} .. {span['stop_utc']} ({span['span_s']:.3f} s)")
-        for d in s["datasets"]:
-            say(f"  {d['path']}: {d['dtype']} {d['shape']}" + (f" [{d['units']}]" if d["units"] else ""))
+        return
+    if s["product_type"] == "slc" and "n_lines" in s:
+        say(f"  {s['n_lines']} lines x {s['n_samples']} samples, algorithm {s['algorithm']}, "
+            f"spacing range {_fmt(s['range_spacing_m'], '.3f')} m x azimuth {_fmt(s['azimuth_spacing_m'], '.3f')} m, "
+            + _full_lines(s['first_full_line'], s['last_full_line']))
+        if s["azimuth_start_utc"]:
+            say(f"  zero-Doppler time {s['azimuth_start_utc']} .. {s['azimuth_stop_utc']} "
+                f"({s['azimuth_span_s']:.3f} s), slant range {_fmt(s['first_range_m'], '.2f')} .. "
+                f"{_fmt(s['last_range_m'], '.2f')} m")
+    elif s["product_type"] == "gbsar_scan" and "n_frequencies" in s:
+        say(f"  status {s['status']}: {s['n_stops_complete']} of {s['n_stops_planned']} stops, polarizations "
+            f"{', '.join(s['polarizations']) or 'none'}, rail {_fmt(s['rail_start_m'], '.3f')} .. "
+            f"{_fmt(s['rail_stop_m'], '.3f')} m")
+        if s["n_frequencies"]:
+            say(f"  sweep {s['frequency_start_hz'] / 1e9:.6g} .. {s['frequency_stop_hz'] / 1e9:.6g} GHz, "
+                f"{s['n_frequencies']} points" + (f", step {s['frequency_step_hz'] / 1e6:.6g} MHz"
+                                                  if s["frequency_step_hz"] else ""))
+    for name, span in s["time_spans"].items():
+        if span:
+            say(f"  {name}: {span['start_utc']} .. {span['stop_utc']} ({span['span_s']:.3f} s)")
+    for d in s["datasets"]:
+        say(f"  {d['path']}: {d['dtype']} {d['shape']}" + (f" [{d['units']}]" if d["units"] else ""))
+
+
+def _bits(bits) -> str:
+    """Quantization of a raw echo: 0 (or absent) means floating-point samples."""
+    return f"{int(bits)}-bit quantized" if bits else "not quantized"
+
+
+def _full_lines(first: int | None, last: int | None) -> str:
+    """The lines focused with the whole synthetic aperture (none when the scene is shorter than one)."""
+    if first is None or last is None:
+        return "fully focused lines unknown"
+    return f"fully focused lines {first}..{last}" if last >= first else "no line has the full aperture"
+
+
+def _fmt(v, spec: str) -> str:
+    return "?" if v is None else format(v, spec)
 
 
 def info(
@@ -150,8 +232,9 @@ def info(
 ) -> None:
     """Summarize a product: type, shape, time span, radar parameters, orbit, provenance.
 
-    Raw products get their radar and orbit summary; any other product type a generic summary of its
-    provenance, attributes and datasets.
+    Raw products get their radar and orbit summary, SLCs their shape, pixel spacings, algorithm and
+    time/range span, GB-SAR scans their polarizations, stops, sweep and status; every product also a
+    generic summary of its provenance, attributes and datasets.
 
     Examples:
 
