@@ -57,6 +57,15 @@ def emit_json(obj: Any) -> None:
     sys.stdout.flush()
 
 
+def require_output_folders(*paths: Any) -> None:
+    """Refuse (one line) an output whose folder does not exist, before any work is done (None: skipped)."""
+    from pathlib import Path
+
+    for p in paths:
+        if p is not None and not Path(p).resolve().parent.is_dir():
+            raise SarcliError(f"output folder {Path(p).resolve().parent} does not exist: create it first")
+
+
 def info(msg: str, quiet: bool = False) -> None:
     """Human-readable progress/info line on stderr (stdout stays clean for --json)."""
     if not quiet:

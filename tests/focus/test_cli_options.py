@@ -53,3 +53,13 @@ def test_focus_json_timings_and_products_honest(cli, tmp_path):
     _one_line_error(q, "finite")
     q = cli("quality", tmp_path / "slc.h5", "--at", "1,inf")
     _one_line_error(q, "finite")
+
+
+def test_focus_missing_output_folders_refused_before_any_work(cli, tmp_path):
+    raw = tmp_path / "raw.h5"
+    assert cli("simulate", SCENE, "-o", raw).exit_code == 0
+    for opt in ("--quicklook", "--geotiff-slant", "-o"):
+        out = ["-o", tmp_path / "slc.h5"] if opt != "-o" else []
+        r = cli("focus", raw, *out, opt, tmp_path / "nope" / "x", "--fdc", "-6558", "--fr", "-1781")
+        _one_line_error(r, "does not exist")
+        assert not (tmp_path / "slc.h5").exists()  # no SLC left behind by a late failure

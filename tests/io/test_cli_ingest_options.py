@@ -31,3 +31,9 @@ def test_bad_ceos_options_refused(cli, make_raw, tmp_path, args, needle):
     r = cli("ingest", tmp_path / "scene", "-o", tmp_path / "x.h5", *args)
     one_line_error(r, needle)
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_missing_output_folder_refused_before_reading(cli, make_raw, tmp_path):
+    write_ceos(tmp_path / "scene", make_raw(n_lines=24))
+    r = cli("ingest", tmp_path / "scene", "-o", tmp_path / "nope" / "x.h5")
+    one_line_error(r, "does not exist")

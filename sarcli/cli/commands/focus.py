@@ -9,7 +9,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, progress_bar
+from sarcli.cli.common import emit_json, info, progress_bar, require_output_folders
 from sarcli.errors import SarcliError
 
 
@@ -97,6 +97,7 @@ def focus(
 
     t_start = time.perf_counter()
     _check_output_options(looks_az, looks_rg, crs, spacing, azimuth_bandwidth, range_band_fraction)
+    require_output_folders(output, geotiff, geotiff_slant, quicklook)
     knobs = {"range_window": range_window, "azimuth_window": azimuth_window,
              "azimuth_bandwidth_hz": azimuth_bandwidth, "range_bandwidth_fraction": range_band_fraction,
              "rcmc": rcmc, "src": src, "precision": "double" if double else "single", "block_lines": block_lines,

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info
+from sarcli.cli.common import emit_json, info, require_output_folders
 from sarcli.errors import SarcliError
 
 F3_PULSES_KNOWN = (8, 9)  # the two published readings of beam F3's pulses in flight (ISCE, ASF MapReady)
@@ -46,6 +46,7 @@ def ingest(
 
     if compression not in (None, "gzip", "lzf"):
         raise SarcliError(f"--compression must be gzip or lzf, got {compression!r}")
+    require_output_folders(output)
     if max_gap < 0:
         raise SarcliError(f"--max-gap must be a number of lines >= 0, got {max_gap}")
     if f3_pulses not in F3_PULSES_KNOWN:

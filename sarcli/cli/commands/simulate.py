@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, progress_bar
+from sarcli.cli.common import emit_json, info, progress_bar, require_output_folders
 from sarcli.errors import SarcliError
 
 
@@ -45,9 +45,7 @@ def simulate(
         raise SarcliError(f"--format must be hdf5 or ceos, got {fmt!r}")
     if compression not in (None, "gzip", "lzf"):
         raise SarcliError(f"--compression must be gzip or lzf, got {compression!r}")
-    parent = output.resolve().parent
-    if not parent.is_dir():
-        raise SarcliError(f"output folder {parent} does not exist: create it first")
+    require_output_folders(output)
     if output.is_dir() and fmt == "hdf5":
         raise SarcliError(f"{output} is a folder: give a file name for the raw product (or --format ceos)")
     sc = load_scene(scene)
