@@ -45,3 +45,10 @@ def test_focus_smallest_accepted_interval_and_plan_criterion(cli, scan, tmp_path
     r = cli("gbsar", "focus", scan, "-o", tmp_path / "img.h5", "--algorithm", "rd", "--max-range", "2.4")
     assert r.exit_code == 0, r.stderr
     _one_line_error(cli("gbsar", "plan", scan, "--criterion-deg", "-5"), "--criterion-deg")
+
+
+def test_focus_missing_output_folder_leaves_no_image(cli, scan, tmp_path):
+    out = tmp_path / "img.h5"
+    for extra in (["--quicklook", tmp_path / "nope" / "q.png"], ["--geotiff", tmp_path / "nope" / "a.tif"]):
+        _one_line_error(cli("gbsar", "focus", scan, "-o", out, *extra), "does not exist")
+        assert not out.exists()

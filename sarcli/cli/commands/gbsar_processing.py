@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from sarcli.cli.common import emit_json, info, progress
+from sarcli.cli.common import emit_json, info, progress, require_output_folders
 from sarcli.cli.gbsar_app import attach, gbsar_app
 from sarcli.errors import SarcliError
 from sarcli.gbsar import C_LIGHT
@@ -215,6 +215,7 @@ def focus_cmd(
     from sarcli.io.scan import read_scan
 
     _check_criterion(criterion_deg)
+    require_output_folders(output, geotiff, enu_geotiff, quicklook)
     s = read_scan(scan)
     _check_range_interval(s, min_range, max_range)
     opts = FocusOptions(algorithm=algorithm, range_window=range_window, azimuth_window=azimuth_window,
