@@ -15,7 +15,8 @@
 
 ``gbsar_ps`` (schema 1), temporal coherence and persistent scatterers::
 
-    /coherence        float32 (n_range, n_azimuth) temporal coherence |sum z_i| / sum |z_i|
+    /coherence        float32 (n_range, n_azimuth) temporal coherence |sum z_i| / sum |z_i|, NaN outside
+                      the common support of the images (as in the interferogram)
     /time_s           float64 (n_scans,) mean scan time after the reference scan's epoch
     /ps/row, /ps/col  int64 (n_ps,) pixel indices; /ps/range, /ps/azimuth (m); /ps/coherence
     /ps/phase         float32 (n_ps, n_scans) rad relative to the first scan

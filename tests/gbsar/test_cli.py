@@ -157,6 +157,7 @@ def test_coherence_ps_series_and_polarimetry(cli, tmp_path):
     assert s["time_s"][1] - s["time_s"][0] == pytest.approx(600.0)
     ps = read_ps(out)
     assert ps["ps_phase"].shape == (s["n_ps"], 3) and np.all(ps["ps_coherence"] >= 0.99)
+    assert np.isnan(ps["coherence"]).any() and np.nanmin(ps["coherence"]) >= 0.0  # blank outside the footprint
     rows = list(csv.reader(csv_path.open()))
     assert rows[0][:4] == ["ps", "azimuth_m", "range_m", "coherence"] and len(rows) == s["n_ps"] + 1
     assert plot.stat().st_size > 1000

@@ -392,6 +392,7 @@ def coherence_cmd(
       sarcli gbsar coherence p1.h5 p2.h5 p3.h5 p4.h5 --threshold 0.99 -o ps.h5 --csv ps.csv --plot ps.png
     """
     from sarcli.errors import SarcliError
+    from sarcli.gbsar.interferometry import support
     from sarcli.gbsar.timeseries import check_series, ps_series, select_ps, temporal_coherence
     from sarcli.io.interferogram import write_ps
 
@@ -402,7 +403,8 @@ def coherence_cmd(
     pol = (pol or imgs[0].polarizations[0]).upper()
     check_series(imgs, pol, [str(p) for p in images])
     stack = np.stack([im.pol(pol) for im in imgs])
-    gamma = temporal_coherence(stack)
+    ok = np.logical_and.reduce([support(im, pol) for im in imgs])
+    gamma = np.where(ok, temporal_coherence(stack), np.nan).astype(np.float32)  # NaN outside the footprint
     rows, cols = select_ps(gamma, np.mean(np.abs(stack), axis=0), threshold, dynamic_range_db)
     phase, disp = ps_series(stack, rows, cols, imgs[0].wavelength_m)
     t = np.array([_seconds_between(imgs[0].epoch_utc, im.epoch_utc) + im.scan_time_s for im in imgs])
@@ -424,7 +426,7 @@ def coherence_cmd(
     if json_out:
         emit_json(summary)
     else:
-        info(f"wrote {output}: {rows.size} PS of {gamma.size} pixels (gamma >= {threshold})")
+        info(f"wrote {output}: {rows.size} PS of {int(ok.sum())} supported pixels (gamma >= {threshold})")
 
 
 def _seconds_between(a: str, b: str) -> float:
