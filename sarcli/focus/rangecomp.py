@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.fft as sfft
-from numba import njit, prange
+from numba import njit
 
 from sarcli.errors import SarcliError
 from sarcli.focus.windows import window
@@ -111,14 +111,15 @@ def inverse_src_rate(f_eta_hz: np.ndarray, r_ref_m: float, v_mps: float, carrier
     return C * r_ref_m * np.asarray(f_eta_hz) ** 2 / (2.0 * v_mps**2 * carrier_hz**3 * d2**1.5)
 
 
-@njit(parallel=True, cache=True, fastmath=True)
+@njit(nogil=True, cache=True, fastmath=True)
 def apply_range_filter_2d(x, h, f_tau, inv_ksrc, out):
     """out[k, j(m)] = x[k, m] * h[m] * exp(-j pi f_tau[m]^2 inv_ksrc[k]) (2-D spectrum, azimuth rows k).
 
     ``out`` has n_out >= n_f columns: the positive-frequency half m < (n_f + 1) // 2 keeps its column,
     the negative half moves to the end (j = m + n_out - n_f) and the columns between are zeroed, i.e.
     Fourier zero padding: the IFFT of ``out`` is the filtered row interpolated on an n_out / n_f finer
-    grid. ``out`` may be ``x`` when n_out == n_f (in place).
+    grid. ``out`` may be ``x`` when n_out == n_f (in place). Serial and GIL-free (the RDA calls it per
+    chunk of rows from a thread pool).
     The phase is quadratic in m on each half of the FFT frequency axis (f_tau linear there), so the
     phasor is advanced by a second-order recurrence (two complex multiplies per sample instead of a
     sine and cosine), restarted exactly every 64 samples: drift below 1e-12 rad.
@@ -126,7 +127,7 @@ def apply_range_filter_2d(x, h, f_tau, inv_ksrc, out):
     na, nf = x.shape
     half = (nf + 1) // 2
     gap = out.shape[1] - nf
-    for k in prange(na):
+    for k in range(na):
         for q in range(half, half + gap):
             out[k, q] = 0.0
         a = -np.pi * inv_ksrc[k]

@@ -28,7 +28,7 @@ geometry and phase.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from sarcli.focus.interp import interpolate_numpy
 from sarcli.focus.windows import table_lookup, window
@@ -51,9 +51,9 @@ def _geometry(fb, i, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba, psh)
 
 
 @njit(inline="always", fastmath=True)
-def _sample(row, p, kind, table, nph, taps, k0):
+def _sample(row, p, kind, table, nph, taps, k0, zero):
     nr = row.shape[0]
-    val = 0.0j
+    val = zero  # accumulate in the data's precision (complex64: no per-tap conversions)
     if kind == 0:
         n = int(np.floor(p + 0.5))
         if 0 <= n < nr:
@@ -79,9 +79,12 @@ def _sample(row, p, kind, table, nph, taps, k0):
     return val
 
 
-@njit(parallel=True, cache=True, fastmath=True)
+@njit(nogil=True, cache=True, fastmath=True)
 def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba, wtab, kind, table, shift, out):
     """Fused RCMC + azimuth matched filter; writes ``out`` (n_az, len(r0)); ``out`` may be ``s``.
+
+    Serial and GIL-free: the RDA runs it on chunks of rows in a thread pool (one kernel call per
+    chunk and thread, no barrier between threads).
 
     Speed: the range position and the phase are computed exactly every SPAN bins and linearly in
     between (a phasor recurrence instead of a sine and cosine per sample; both vary smoothly with
@@ -93,8 +96,17 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
     nph = table.shape[0] - 1
     taps = table.shape[1]
     k0 = taps // 2 - 1
-    for k in prange(na):
-        row = s[k, :].copy()  # the row is read whole before it is overwritten: in place is allowed
+    # in place is allowed: when out overlaps s, each row is copied before it is overwritten
+    s_lo = s.ctypes.data
+    s_hi = s_lo + (s.shape[0] - 1) * s.strides[0] + (s.shape[1] - 1) * s.strides[1] + s.itemsize
+    o_lo = out.ctypes.data
+    o_hi = o_lo + (out.shape[0] - 1) * out.strides[0] + (out.shape[1] - 1) * out.strides[1] + out.itemsize
+    alias = o_lo < s_hi and s_lo < o_hi
+    zero = np.zeros(1, s.dtype)[0]
+    for k in range(na):
+        row = s[k, :]
+        if alias:
+            row = row.copy()
         fb = f_bin[k]
         psh = -2.0 * np.pi * fb * shift / prf
         i0 = 0
@@ -121,7 +133,7 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
                 if u < -0.5 or u > 0.5:
                     out[k, i] = 0.0
                     continue
-                out[k, i] = _sample(row, p, kind, table, nph, taps, k0) * table_lookup(wtab, u) * ph_c
+                out[k, i] = _sample(row, p, kind, table, nph, taps, k0, zero) * table_lookup(wtab, u) * ph_c
             i0 = stop
 
 

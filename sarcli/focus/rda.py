@@ -33,9 +33,12 @@ reports it against a 1536 x 2048 input, including the output image).
 from __future__ import annotations
 
 import math
+import os
+import queue
 import time
 import warnings
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -257,14 +260,25 @@ def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan
     return _Plan(prf, ranges, lam, ba, shift, pad, n_fft_az, n_valid, n_fft_r, aperture)
 
 
-def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int) -> None:
-    """FFT of ``y`` along ``axis`` in place (scipy's pocketfft writes into ``y`` with overwrite_x)."""
-    r = (sfft.ifft if inverse else sfft.fft)(y, axis=axis, overwrite_x=True, workers=workers)
-    if not np.may_share_memory(r, y):
-        y[...] = r
+def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int, cols: int = 256) -> None:
+    """FFT of ``y`` along ``axis`` in place (scipy's pocketfft writes into ``y`` with overwrite_x).
+
+    Along axis 0 in chunks of ``cols`` columns: 1.8x faster than one call on a 2304 x 2880 block
+    (cache: bench machine, single thread).
+    """
+    f = sfft.ifft if inverse else sfft.fft
+    for c in range(0, y.shape[1], cols if axis == 0 else y.shape[1]):
+        v = y[:, c:c + cols] if axis == 0 else y
+        r = f(v, axis=axis, overwrite_x=True, workers=workers)
+        if not np.may_share_memory(r, v):
+            v[...] = r
 
 
-def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wtab, kind, table, workers, timings,
+def _n_threads(workers: int) -> int:
+    return max(1, os.cpu_count() or 1) if workers < 0 else max(1, workers)
+
+
+def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wtab, kind, table, workers,
                       rows=CHUNK):
     """Range filter (+ SRC), upsampling and RCMC + azimuth filter of the 2-D spectrum ``y`` (N x L).
 
@@ -275,6 +289,8 @@ def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wt
     factor 2 the data sit below a quarter of the sampling rate, where the windowed sinc is flat (a
     Radarsat-1 chirp is sampled at only 1.07 x its band: bench). ``factor`` is folded into the window
     table (the IFFT of the longer spectrum divides by factor x L instead of L).
+    Chunks go to a pool of ``workers`` threads (serial GIL-free kernels, single-threaded FFTs, one
+    buffer per thread): no synchronization inside a chunk, so a busy machine slows it gracefully.
     """
     n_fft = y.shape[1]
     f_tau = sfft.fftfreq(n_fft, 1.0 / fs)
@@ -288,17 +304,27 @@ def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wt
     out[~active] = 0.0
     edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
     chunks = [(c, min(b, c + rows)) for a, b in zip(edges[::2], edges[1::2], strict=True) for c in range(a, b, rows)]
-    buf = np.empty((min(rows, y.shape[0]), factor * n_fft), y.dtype)
-    for c, d in chunks:
-        t0 = time.perf_counter()
+    n_threads = min(_n_threads(workers), max(1, len(chunks)))
+    buffers: queue.SimpleQueue = queue.SimpleQueue()
+    for _ in range(n_threads):
+        buffers.put(np.empty((min(rows, y.shape[0]), factor * n_fft), y.dtype))
+
+    def run(c: int, d: int) -> None:
+        buf = buffers.get()
         up = buf[:d - c]
         apply_range_filter_2d(y[c:d], h, f_tau, inv_k[c:d], up)
-        _fft_inplace(up, 1, True, workers)
-        t1 = time.perf_counter()
+        _fft_inplace(up, 1, True, 1)
         rcmc_azimuth(up, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
                      p.prf, p.ba, w, kind, table, p.shift, out[c:d])
-        timings["range_filter_ifft_s"] += t1 - t0
-        timings["rcmc_azimuth_s"] += time.perf_counter() - t1
+        buffers.put(buf)
+
+    if n_threads == 1:
+        for c, d in chunks:
+            run(c, d)
+        return
+    with ThreadPoolExecutor(n_threads) as pool:
+        for f in [pool.submit(run, c, d) for c, d in chunks]:
+            f.result()
 
 
 def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
@@ -311,7 +337,7 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
     """
     k = knobs
     t_start = time.perf_counter()
-    timings = {"range_fft_s": 0.0, "azimuth_fft_s": 0.0, "range_filter_ifft_s": 0.0, "rcmc_azimuth_s": 0.0,
+    timings = {"range_fft_s": 0.0, "azimuth_fft_s": 0.0, "range_filter_rcmc_azimuth_s": 0.0,
                "azimuth_ifft_s": 0.0, "io_s": 0.0}
     radar = raw.radar
     n_lines = shape[0]
@@ -377,8 +403,10 @@ def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
             off_f = f_bin - fdc[nr // 2]
             f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
             inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
+        t0 = time.perf_counter()
         _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, radar.range_sampling_rate_hz, k.rcmc_oversample, v, fdc,
-                          dt_orbit, ph_orbit, wtab, kind, table, k.workers, timings)
+                          dt_orbit, ph_orbit, wtab, kind, table, k.workers)
+        timings["range_filter_rcmc_azimuth_s"] += time.perf_counter() - t0
         img = y[:, :nr]
         t0 = time.perf_counter()
         _fft_inplace(img, 0, True, k.workers)
