@@ -495,10 +495,12 @@ def polarimetry_cmd(
 
       sarcli gbsar polarimetry image.h5 --png nd.png --geotiff nd.tif
     """
+    from sarcli.gbsar.interferometry import support
     from sarcli.gbsar.polarimetry import normalized_difference
 
     img = _load_image(image)
     nd = normalized_difference(img.pol("HH"), img.pol("VV"), window)
+    nd[~(support(img, "HH") & support(img, "VV"))] = np.nan  # blank outside the beam footprint
     summary = {"mean": float(np.nanmean(nd)), "fraction_hh_dominant": float(np.nanmean(nd > 0))}
     summary.update(_map_outputs(nd, img, geotiff, png, "(HH-VV)/(HH+VV)", "normalized difference", "RdBu_r",
                                 -1.0, 1.0, map_pixel))
