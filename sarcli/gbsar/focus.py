@@ -87,6 +87,9 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
     centre = 0.5 * (x[0] + x[-1])
     j0, j1 = math.ceil((centre - width / 2 - x[0]) / step), math.floor((centre + width / 2 - x[0]) / step)
     azimuths = x[0] + step * np.arange(j0, j1 + 1)
+    if azimuths.size < 1:
+        raise SarcliError(f"the image width {width:g} m holds no azimuth pixel of {step:g} m: give --width at "
+                          f"least {step:g} m")
     return Grid(ranges=ranges, azimuths=azimuths)
 
 

@@ -31,6 +31,10 @@ def scan(tmp_path_factory):
     (["--max-range", "2.0"], "fewer than 4 range bins"),
     (["--min-range", "10", "--max-range", "11"], "fewer than 4 range bins"),
     (["--min-range", "-1"], "--min-range"),
+    (["--min-range", "100"], "below the unambiguous range R_max = 74.95 m"),  # c / (4 * 1 MHz)
+    (["--width", "0"], "--width must be a positive"),
+    (["--width", "0.01"], "holds no azimuth pixel of 0.3 m"),  # pixel round(0.5855/2 / 0.05) = 6 steps
+    (["--n-xfft", "0"], "--n-xfft must be a positive"),
     (["--criterion-deg", "400"], "--criterion-deg must be in (0, 180]"),
     (["--criterion-deg", "0"], "--criterion-deg must be in (0, 180]"),
 ])

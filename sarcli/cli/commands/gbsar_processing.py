@@ -164,7 +164,11 @@ def _check_range_interval(scan, min_range: float, max_range: float | None) -> No
         raise SarcliError(f"--max-range must be a positive range in metres, got {max_range:g}")
     df = check_sweep(scan.frequency)
     dr = C_LIGHT / (2 * next_pow2(scan.frequency.size) * df)
-    top = C_LIGHT / (4 * df) if max_range is None else min(max_range, C_LIGHT / (4 * df))
+    r_max = C_LIGHT / (4 * df)
+    if min_range > r_max - MIN_RANGE_BINS * dr:
+        raise SarcliError(f"--min-range {min_range:g} m leaves fewer than {MIN_RANGE_BINS} range bins below the "
+                          f"unambiguous range R_max = {r_max:.4g} m of this sweep")
+    top = r_max if max_range is None else min(max_range, r_max)
     if top - min_range < MIN_RANGE_BINS * dr:
         raise SarcliError(f"the range interval {min_range:g}-{top:g} m holds fewer than {MIN_RANGE_BINS} range bins "
                           f"of {dr:.3g} m (R_max {C_LIGHT / (4 * df):.4g} m): give --max-range at least "
@@ -215,6 +219,10 @@ def focus_cmd(
     from sarcli.io.scan import read_scan
 
     _check_criterion(criterion_deg)
+    if width is not None and not (math.isfinite(width) and width > 0):
+        raise SarcliError(f"--width must be a positive azimuth extent in metres, got {width:g}")
+    if n_xfft is not None and n_xfft < 1:
+        raise SarcliError(f"--n-xfft must be a positive FFT size, got {n_xfft}")
     require_output_folders(output, geotiff, enu_geotiff, quicklook)
     s = read_scan(scan)
     _check_range_interval(s, min_range, max_range)
