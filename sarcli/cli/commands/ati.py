@@ -260,8 +260,9 @@ def _pngs(folder: Path, pair, res, after, conv, mid: int, y_of) -> None:
     from sarcli.ati.plots import psf_plot
     from sarcli.io.images import write_quicklook
 
-    if not folder.is_dir():
+    if folder.exists() and not folder.is_dir():
         raise SarcliError(f"--png-dir {folder} is not a folder")
+    folder.mkdir(parents=True, exist_ok=True)
     n = pair.z0.shape[0]
     ranges = pair.slc0.slant_range
     cols = slice(max(0, res.cols.start - 20), min(ranges.size, res.cols.stop + 20))
