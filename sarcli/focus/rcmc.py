@@ -51,9 +51,10 @@ def _geometry(fb, i, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba, psh)
 
 
 @njit(inline="always", fastmath=True)
-def _sample(row, p, kind, table, nph, taps, k0, zero):
+def _sample(row, p, kind, zero):
+    """Nearest (kind 0) or linear (kind 1) interpolation of ``row`` at p (zeros outside)."""
     nr = row.shape[0]
-    val = zero  # accumulate in the data's precision (complex64: no per-tap conversions)
+    val = zero
     if kind == 0:
         n = int(np.floor(p + 0.5))
         if 0 <= n < nr:
@@ -61,21 +62,10 @@ def _sample(row, p, kind, table, nph, taps, k0, zero):
     else:
         n = int(np.floor(p))
         mu = p - n
-        if kind == 1:
-            if 0 <= n < nr:
-                val += row[n] * (1.0 - mu)
-            if 0 <= n + 1 < nr:
-                val += row[n + 1] * mu
-        else:
-            jp = int(mu * nph + 0.5)
-            if k0 <= n and n - k0 + taps <= nr:
-                for q in range(taps):
-                    val += row[n - k0 + q] * table[jp, q]
-            else:
-                for q in range(taps):
-                    m = n - k0 + q
-                    if 0 <= m < nr:
-                        val += row[m] * table[jp, q]
+        if 0 <= n < nr:
+            val += row[n] * (1.0 - mu)
+        if 0 <= n + 1 < nr:
+            val += row[n + 1] * mu
     return val
 
 
@@ -103,6 +93,7 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
     o_hi = o_lo + (out.shape[0] - 1) * out.strides[0] + (out.shape[1] - 1) * out.strides[1] + out.itemsize
     alias = o_lo < s_hi and s_lo < o_hi
     zero = np.zeros(1, s.dtype)[0]
+    nrow = s.shape[1]
     for k in range(na):
         row = s[k, :]
         if alias:
@@ -133,7 +124,21 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
                 if u < -0.5 or u > 0.5:
                     out[k, i] = 0.0
                     continue
-                out[k, i] = _sample(row, p, kind, table, nph, taps, k0, zero) * table_lookup(wtab, u) * ph_c
+                if kind == 2:  # written out here: numba's inlining of _sample made this loop 2x slower
+                    n = int(np.floor(p))
+                    jp = int((p - n) * nph + 0.5)
+                    b = n - k0
+                    val = zero
+                    if b >= 0 and b + taps <= nrow:
+                        for q in range(taps):
+                            val += row[b + q] * table[jp, q]
+                    else:
+                        for q in range(taps):
+                            if 0 <= b + q < nrow:
+                                val += row[b + q] * table[jp, q]
+                else:
+                    val = _sample(row, p, kind, zero)
+                out[k, i] = val * (table_lookup(wtab, u) * ph_c)
             i0 = stop
 
 
