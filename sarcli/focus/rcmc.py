@@ -125,17 +125,17 @@ def rcmc_azimuth(s, f_bin, r_first, dr, r0, v, fdc, dt, ph0, wavelength, prf, ba
                     out[k, i] = 0.0
                     continue
                 if kind == 2:  # written out here: numba's inlining of _sample made this loop 2x slower
-                    n = int(np.floor(p))
-                    jp = int((p - n) * nph + 0.5)
-                    b = n - k0
+                    j = int(np.floor(p))
+                    jp = int((p - j) * nph + 0.5)
+                    b = j - k0
                     val = zero
                     if b >= 0 and b + taps <= nrow:
-                        for q in range(taps):
-                            val += row[b + q] * table[jp, q]
+                        for t in range(taps):
+                            val += row[b + t] * table[jp, t]
                     else:
-                        for q in range(taps):
-                            if 0 <= b + q < nrow:
-                                val += row[b + q] * table[jp, q]
+                        for t in range(taps):
+                            if 0 <= b + t < nrow:
+                                val += row[b + t] * table[jp, t]
                 else:
                     val = _sample(row, p, kind, zero)
                 out[k, i] = val * (table_lookup(wtab, u) * ph_c)

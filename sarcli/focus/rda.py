@@ -311,12 +311,14 @@ def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wt
 
     def run(c: int, d: int) -> None:
         buf = buffers.get()
-        up = buf[:d - c]
-        apply_range_filter_2d(y[c:d], h, f_tau, inv_k[c:d], up)
-        _fft_inplace(up, 1, True, 1)
-        rcmc_azimuth(up, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
-                     p.prf, p.ba, w, kind, table, p.shift, out[c:d])
-        buffers.put(buf)
+        try:
+            up = buf[:d - c]
+            apply_range_filter_2d(y[c:d], h, f_tau, inv_k[c:d], up)
+            _fft_inplace(up, 1, True, 1)
+            rcmc_azimuth(up, f_bin[c:d], float(p.ranges[0]), dr / factor, p.ranges, v, fdc, dt, ph0, p.wavelength,
+                         p.prf, p.ba, w, kind, table, p.shift, out[c:d])
+        finally:
+            buffers.put(buf)  # also on error: the other chunks must not wait for this buffer
 
     if n_threads == 1:
         for c, d in chunks:
