@@ -28,7 +28,7 @@ def test_parse_orbit_and_linear():
 def test_samples_parse():
     from tests.conftest import SAMPLES
 
-    for name in ("rs1_point.toml", "rs1_clutter.toml", "airborne_ati.toml"):
+    for name in ("rs1_point.toml", "rs1_clutter.toml", "ati_paper.toml"):
         load_scene(SAMPLES / name)
 
 

@@ -31,9 +31,9 @@ def simulate(
 
       sarcli simulate samples/rs1_point.toml --format ceos -o demo/ceos
 
-      sarcli simulate samples/airborne_ati.toml -o ati.h5 --json
+      sarcli simulate samples/ati_paper.toml -o ati.h5 --json
 
-      sarcli simulate samples/airborne_ati.toml -o ati_run7.h5 --seed 7
+      sarcli simulate samples/ati_paper.toml -o ati_run7.h5 --seed 7
     """
     import time
 
