@@ -66,8 +66,13 @@ def require_output_folders(*paths: Any) -> None:
             raise SarcliError(f"output folder {Path(p).resolve().parent} does not exist: create it first")
 
 
+def report(msg: str) -> None:
+    """A line of the command's result for people (stdout: `sarcli info f.h5 | less` works)."""
+    typer.echo(msg)
+
+
 def info(msg: str, quiet: bool = False) -> None:
-    """Human-readable progress/info line on stderr (stdout stays clean for --json)."""
+    """Human-readable progress/status line on stderr (stdout stays clean for --json)."""
     if not quiet:
         typer.echo(msg, err=True)
 

@@ -22,10 +22,10 @@ def test_unquantized_raw_says_not_quantized(cli, make_raw, tmp_path):
     raw.radar = dataclasses.replace(raw.radar, quantization_bits=0)
     raw.echo = raw.echo.astype(np.complex64) * np.float32(0.3)
     write_raw(tmp_path / "r.h5", raw)
-    human = cli("info", tmp_path / "r.h5").stderr
+    human = cli("info", tmp_path / "r.h5").stdout
     assert "not quantized" in human and "0 bit" not in human
     write_raw(tmp_path / "q.h5", make_raw(n_lines=20))
-    assert "4-bit quantized" in cli("info", tmp_path / "q.h5").stderr
+    assert "4-bit quantized" in cli("info", tmp_path / "q.h5").stdout
 
 
 def test_slc_summary_has_key_parameters(cli, tmp_path):
@@ -40,8 +40,8 @@ def test_slc_summary_has_key_parameters(cli, tmp_path):
     assert s["azimuth_span_s"] == pytest.approx(511 / 1256.9846363282768, rel=1e-6)
     assert s["last_range_m"] - s["first_range_m"] == pytest.approx(299 * C / (2 * 32317075.0), rel=1e-9)
     # 512 lines at 1257 Hz are shorter than the 15 m antenna's aperture: no line has the full aperture
-    assert s["first_full_line"] > s["last_full_line"] and "no line has the full aperture" in cli("info", slc).stderr
-    human = cli("info", slc).stderr
+    assert s["first_full_line"] > s["last_full_line"] and "no line has the full aperture" in cli("info", slc).stdout
+    human = cli("info", slc).stdout
     assert "512 lines x 300 samples, algorithm rd, spacing range 4.638 m" in human
     assert "zero-Doppler time 2002-06-16T" in human
 
@@ -57,6 +57,6 @@ def test_scan_summary_has_key_parameters(cli, tmp_path):
     assert s["frequency_start_hz"] == pytest.approx(5.2e9) and s["frequency_stop_hz"] == pytest.approx(5.4e9)
     assert s["frequency_step_hz"] == pytest.approx(1e6)
     assert s["rail_start_m"] == pytest.approx(-0.5) and s["rail_stop_m"] == pytest.approx(0.5)
-    human = cli("info", tmp_path / "scan.h5").stderr
+    human = cli("info", tmp_path / "scan.h5").stdout
     assert "status simulated: 21 of 21 stops, polarizations VV, HH" in human
     assert "sweep 5.2 .. 5.4 GHz, 201 points, step 1 MHz" in human

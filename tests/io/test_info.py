@@ -40,7 +40,7 @@ def test_raw_info_keys_and_values(cli, make_raw, tmp_path):
     assert s["has_replica"] and s["has_agc"] and not s["has_truth"]
     assert s["provenance"]["product_type"] == "raw"
     human = cli("info", tmp_path / "r.h5")
-    assert human.exit_code == 0 and "raw product" in human.stderr and "15 state vectors (ECI)" in human.stderr
+    assert human.exit_code == 0 and "raw product" in human.stdout and "15 state vectors (ECI)" in human.stdout
 
 
 def test_generic_product_summary(cli, tmp_path):
@@ -58,7 +58,7 @@ def test_generic_product_summary(cli, tmp_path):
     assert s["time_spans"] == {"/azimuth_time": {"start_utc": "2002-06-16T15:41:10.000000Z",
                                                  "stop_utc": "2002-06-16T15:41:15.500000Z", "span_s": 5.5}}
     human = cli("info", tmp_path / "s.h5")
-    assert "slc product" in human.stderr and "/range_m: float64 [34] [m]" in human.stderr
+    assert "slc product" in human.stdout and "/range_m: float64 [34] [m]" in human.stdout
 
 
 def test_info_refuses_non_products(cli, tmp_path):

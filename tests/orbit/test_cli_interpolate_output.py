@@ -28,7 +28,7 @@ def test_csv_prints_one_summary_line(cli, product, tmp_path):
 def test_table_has_acceleration_matching_gravity(cli, product, polar_truth):
     r = cli("orbit", "interpolate", product, "-t", "480,960")
     assert r.exit_code == 0, r.stderr
-    lines = r.stderr.strip().splitlines()
+    lines = r.stdout.strip().splitlines()
     head = lines[1].split()
     assert head[-3:] == ["ax_mps2", "ay_mps2", "az_mps2"]
     rows = np.array([[float(x) for x in ln.split()] for ln in lines[2:]])

@@ -9,7 +9,7 @@ from typing import Any
 import typer
 
 from sarcli.cli.common import emit_json
-from sarcli.cli.common import info as say
+from sarcli.cli.common import report as say
 
 
 def _attrs(obj) -> dict[str, Any]:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, make_typer
+from sarcli.cli.common import emit_json, info, make_typer, report
 from sarcli.errors import SarcliError
 
 orbit_app = make_typer(help="Orbit state vectors: summary, Hermite interpolation, accuracy/cost tables.")
@@ -139,25 +139,25 @@ def info_cmd(
     if as_json:
         emit_json(s)
         return
-    info(f"{raw_path}: {s['n_vectors']} state vectors ({s['frame']}), {s['start_utc']} .. {s['stop_utc']}")
-    info(f"  spacing {s['spacing_s']:.6g} s (min {s['spacing_min_s']:.6g}, max {s['spacing_max_s']:.6g}); "
+    report(f"{raw_path}: {s['n_vectors']} state vectors ({s['frame']}), {s['start_utc']} .. {s['stop_utc']}")
+    report(f"  spacing {s['spacing_s']:.6g} s (min {s['spacing_min_s']:.6g}, max {s['spacing_max_s']:.6g}); "
          f"Hermite default N = {s['default_n_nodes']}")
     cover = "inside" if s["echo_covered"] else "NOT inside (interpolation will refuse the lines outside)"
-    info(f"  echo {s['echo_start_s']:.6f} .. {s['echo_stop_s']:.6f} s: {cover} the span; margins "
+    report(f"  echo {s['echo_start_s']:.6f} .. {s['echo_stop_s']:.6f} s: {cover} the span; margins "
          f"{s['margin_before_s']:.1f} s before, {s['margin_after_s']:.1f} s after")
     g = s.get("geometry") or {}
     if "altitude_m" in g:
-        info(f"  scene centre t = {g['scene_center_time_s']:.6f} s: {g['pass']} pass, sub-satellite lat "
+        report(f"  scene centre t = {g['scene_center_time_s']:.6f} s: {g['pass']} pass, sub-satellite lat "
              f"{g['sub_satellite_lat_deg']:.4f} deg, lon {g['sub_satellite_lon_deg']:.4f} deg, "
              f"altitude {g['altitude_m'] / 1e3:.3f} km, ECEF speed {g['ecef_speed_mps']:.2f} m/s")
     if "look_angle_deg" in g:
-        info("  zero-Doppler look / incidence at slant range " + ", ".join(
+        report("  zero-Doppler look / incidence at slant range " + ", ".join(
             f"{r / 1e3:.3f} km: {lk:.4f} / {ic:.4f} deg" for r, lk, ic in
             zip(g["zero_doppler_slant_range_m"], g["look_angle_deg"], g["incidence_angle_deg"], strict=True)))
     if "geometry_note" in g:
-        info(f"  geometry: {g['geometry_note']}")
+        report(f"  geometry: {g['geometry_note']}")
     if "gha_minus_gmst_deg" in s:
-        info(f"  frame check: product hour angle - GMST = {s['gha_minus_gmst_deg']:.6f} deg "
+        report(f"  frame check: product hour angle - GMST = {s['gha_minus_gmst_deg']:.6f} deg "
              f"({s['gha_minus_gmst_ground_m']:.1f} m at the equator)")
 
 
@@ -241,13 +241,13 @@ def interpolate_cmd(
         info(f"wrote {csv}: {t.size} row(s), {sv.frame}, Hermite N = {N}, t {t.min():.6f}..{t.max():.6f} s, "
              f"columns {', '.join(cols)}")
         return
-    info(f"{sv.frame}, Hermite N = {N}, {t.size} time(s)")
+    report(f"{sv.frame}, Hermite N = {N}, {t.size} time(s)")
     head = list(cols)
-    info(" ".join(f"{h:>16}" for h in head))
+    report(" ".join(f"{h:>16}" for h in head))
     for i in range(min(t.size, 1000)):
-        info(" ".join(f"{cols[h][i]:16.6f}" for h in head))
+        report(" ".join(f"{cols[h][i]:16.6f}" for h in head))
     if t.size > 1000:
-        info(f"... {t.size - 1000} more rows (use --csv or --json)")
+        report(f"... {t.size - 1000} more rows (use --csv or --json)")
 
 
 def _write_csv(path: Path, cols: dict) -> None:
@@ -292,22 +292,22 @@ def accuracy_cmd(
     if as_json:
         emit_json(result)
         return
-    info("Hermite interpolation, 15 x 480 s J2 truth (interior = >= 2 spacings from the ends):")
-    info(f"{'N':>3} {'pos int. m':>11} {'vel int. m/s':>13} {'pos ends m':>11} {'vel ends m/s':>13}"
+    report("Hermite interpolation, 15 x 480 s J2 truth (interior = >= 2 spacings from the ends):")
+    report(f"{'N':>3} {'pos int. m':>11} {'vel int. m/s':>13} {'pos ends m':>11} {'vel ends m/s':>13}"
          + (f" {'M evals/s':>10}" if timing else ""))
     for r in result["hermite"]:
-        info(f"{r['n_nodes']:3d} {r['pos_err_interior_m']:11.3g} {r['vel_err_interior_mps']:13.3g} "
+        report(f"{r['n_nodes']:3d} {r['pos_err_interior_m']:11.3g} {r['vel_err_interior_mps']:13.3g} "
              f"{r['pos_err_ends_m']:11.3g} {r['vel_err_ends_mps']:13.3g}"
              + (f" {r['evals_per_s'] / 1e6:10.1f}" if timing else ""))
     fl = result["truth_floor"]
-    info(f"  (truth floor {fl['pos_m']:.2g} m, {fl['vel_mps']:.2g} m/s)")
-    info("Control rotation, exact vs small-angle (x Radarsat-1 limits pitch 0.03 deg, yaw 0.004 deg):")
+    report(f"  (truth floor {fl['pos_m']:.2g} m, {fl['vel_mps']:.2g} m/s)")
+    report("Control rotation, exact vs small-angle (x Radarsat-1 limits pitch 0.03 deg, yaw 0.004 deg):")
     for r in result["attitude"]:
-        info(f"  x{r['scale']:<5g} pointing {r['pointing_err_urad']:10.4g} urad, "
+        report(f"  x{r['scale']:<5g} pointing {r['pointing_err_urad']:10.4g} urad, "
              f"Doppler {r['doppler_err_hz']:10.4g} Hz, ground {r['ground_err_m']:10.4g} m")
-    info("Earth frame model, metres at the ground:")
+    report("Earth frame model, metres at the ground:")
     for r in result["frames"]:
-        info(f"  {r['hypothesis']:<48} {r['ground_m']:10.1f} m")
+        report(f"  {r['hypothesis']:<48} {r['ground_m']:10.1f} m")
 
 
 def _accuracy_plot(path: Path, truth) -> None:

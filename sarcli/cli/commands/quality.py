@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info
+from sarcli.cli.common import emit_json, report
 from sarcli.errors import SarcliError
 
 
@@ -60,7 +60,7 @@ def quality(
         return
     for i, m in enumerate(res):
         err = f", position error {m['position_error_m']:.3f} m" if "position_error_m" in m else ""
-        info(f"target {i}: t {m['azimuth_time_s']:.6f} s, R {m['range_m']:.2f} m; IRW rg {m['irw_range_m']:.2f} m, "
+        report(f"target {i}: t {m['azimuth_time_s']:.6f} s, R {m['range_m']:.2f} m; IRW rg {m['irw_range_m']:.2f} m, "
              f"az {m['irw_azimuth_m']:.2f} m; PSLR rg {m['pslr_range_db']:.2f} dB, az {m['pslr_azimuth_db']:.2f} dB; "
              f"ISLR rg {m['islr_range_db']:.2f} dB, az {m['islr_azimuth_db']:.2f} dB{err}")
 
