@@ -60,7 +60,7 @@ from sarcli.io.raw import RawProduct
 from sarcli.io.slc import SLC, DopplerUsed
 
 RANGE_GUARD = 64  # range samples beyond the correlation's wrap-free length (SRC impulse response)
-CHUNK = 128  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass
+CHUNK = 64  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass
 
 
 def smooth_len(n: int) -> int:
