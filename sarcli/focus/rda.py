@@ -275,7 +275,10 @@ def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int, cols: in
 
 
 def _n_threads(workers: int) -> int:
-    return max(1, os.cpu_count() or 1) if workers < 0 else max(1, workers)
+    """Threads for the chunk pool: ``workers`` (scipy's convention: negative = every usable core)."""
+    if workers >= 0:
+        return max(1, workers)
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else max(1, os.cpu_count() or 1)
 
 
 def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wtab, kind, table, workers,
