@@ -35,7 +35,7 @@ from orbit.errors import InterpolationRangeError, StateVectorError
 from orbit.frames import ecef_to_eci, eci_to_ecef
 
 FRAMES = ("ECI", "ECEF", "LOCAL")
-DEFAULT_N_NODES = 10  # from the accuracy/cost table (docs/readme/30-orbit.md): 10x margin on both bars
+DEFAULT_N_NODES = 10  # from the accuracy/cost table (README, section Orbit): 10x margin on both bars
 MIN_N_NODES, MAX_N_NODES = 2, 16
 _NEAR_DUPLICATE = 1e-6  # a spacing below this fraction of the median spacing is a duplicate
 

@@ -5,7 +5,7 @@ the simulator computes only the listed effects. Every mistake (unknown key, unkn
 type, impossible value) is a one-line :class:`sarcli.errors.FormatError` naming the file and key.
 Units: SI; angles in degrees in the file (``*_deg`` keys), radians in the dataclasses.
 Times: seconds after ``scene.epoch_utc``; target azimuth times are relative to the scene centre.
-See ``docs/readme/10-simulate.md`` for the format with examples.
+See the README (section ``sarcli simulate``) for the format with examples.
 """
 
 from __future__ import annotations

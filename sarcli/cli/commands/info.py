@@ -140,7 +140,7 @@ def _int(v) -> int | None:
 
 
 def summarize(path: Path) -> dict[str, Any]:
-    """A JSON-ready summary of any sarcli product (keys documented in docs/readme/20-ingest-info.md)."""
+    """A JSON-ready summary of any sarcli product (keys documented in the README, section Ingest)."""
     from sarcli.io.h5common import PROVENANCE_ATTRS, open_product, provenance
 
     with open_product(path) as f:
