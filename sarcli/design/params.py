@@ -117,17 +117,27 @@ def validate(p: DesignParams, where: str) -> DesignParams:
     return p
 
 
-def from_toml(path: str | Path) -> DesignParams:
-    """Read the ``[design]`` table of a TOML file."""
-    path = Path(path)
+def _read_toml(path: Path) -> dict:
     try:
-        doc = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as e:
         raise SarcliError(f"{path}: not valid TOML ({e})") from None
+
+
+def from_toml(path: str | Path, doc: dict | None = None) -> DesignParams:
+    """Read the ``[design]`` table of a TOML file (``doc``: the file already parsed)."""
+    path = Path(path)
+    doc = _read_toml(path) if doc is None else doc
     if "design" not in doc:
         raise SarcliError(f"{path}: no [design] table (see samples/aod_ccd_example.toml)")
     d = dict(doc["design"])
-    proc = Processor(**{k: v for k, v in d.pop("processor", {}).items() if k in {f.name for f in fields(Processor)}})
+    proc_table = dict(d.pop("processor", {}))
+    proc_known = {f.name for f in fields(Processor)}
+    extra = sorted(set(proc_table) - proc_known)
+    if extra:
+        raise SarcliError(f"{path}: unknown [design.processor] key(s) {', '.join(extra)}; "
+                          f"known: {', '.join(sorted(proc_known))}")
+    proc = Processor(**proc_table)
     known = {f.name for f in fields(DesignParams)} - {"processor", "source"}
     unknown = sorted(set(d) - known)
     if unknown:
@@ -262,12 +272,9 @@ def load(path: str | Path) -> DesignParams:
     if not path.exists():
         raise SarcliError(f"{path}: no such file")
     if path.suffix.lower() == ".toml":
-        try:
-            doc = tomllib.loads(path.read_text())
-        except tomllib.TOMLDecodeError as e:
-            raise SarcliError(f"{path}: not valid TOML ({e})") from None
+        doc = _read_toml(path)
         if "design" in doc or not ("platform" in doc or "rail" in doc):
-            return from_toml(path)
+            return from_toml(path, doc)
         return from_stripmap_scene(path) if "platform" in doc else from_gbsar_scene(path)
     from sarcli.io.h5common import attr_str, open_product
 

@@ -336,11 +336,3 @@ def raw_shape(path: str | os.PathLike) -> tuple[int, int]:
     """(n_lines, n_samples) without reading the echo."""
     with open_product(path, PRODUCT_TYPE) as f:
         return tuple(require(f, "echo", path, shape_rank=2).shape)  # type: ignore[return-value]
-
-
-def is_h5(path: str | os.PathLike) -> bool:
-    """True if the file is HDF5 (by signature)."""
-    try:
-        return h5py.is_hdf5(path)
-    except OSError:
-        return False

@@ -89,16 +89,15 @@ def emulate(raw: RawProduct, limitations: frozenset[str] | str = frozenset(),
     valid_lo, valid_hi = tau0 + r.pulse_length_s / 2, tau0 + (n_samples - 1) / fs - r.pulse_length_s / 2
     if valid_hi <= valid_lo:
         raise SarcliError("the range window is shorter than one pulse: nothing can be range-compressed")
-    centre = (valid_lo + valid_hi) / 2 if centre_range_m is None else 2 * centre_range_m / C_LIGHT
-    des = design(B, r.pulse_length_s, centre, settings, max_pulses=None if "ccd_size" in lims else n_lines)
     ccd = settings.ccd
-    if "ccd_size" in lims:
-        n_cols = ccd.columns
-    else:  # the whole valid window at the same pixel delay
-        n_cols = int(math.floor((valid_hi - valid_lo) / des.pixel_delay_s))
-        des = design(B, r.pulse_length_s, (valid_lo + valid_hi) / 2, settings, max_pulses=n_lines)
+    finite_ccd = "ccd_size" in lims  # else: columns over the whole valid window, every line integrated
+    centre = (valid_lo + valid_hi) / 2
+    if finite_ccd and centre_range_m is not None:
+        centre = 2 * centre_range_m / C_LIGHT
+    des = design(B, r.pulse_length_s, centre, settings, max_pulses=None if finite_ccd else n_lines)
+    n_cols = ccd.columns if finite_ccd else int(math.floor((valid_hi - valid_lo) / des.pixel_delay_s))
     col_delay = des.centre_delay_s + (np.arange(n_cols) - (n_cols - 1) / 2) * des.pixel_delay_s
-    rows = min(des.aperture_pulses, n_lines) if "ccd_size" in lims else n_lines
+    rows = min(des.aperture_pulses, n_lines) if finite_ccd else n_lines
     rows -= 1 - rows % 2  # odd: the mask's centre row is a row
     dnu = des.reference_offset_hz
 

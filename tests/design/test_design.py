@@ -165,6 +165,8 @@ def test_cli_human_output(cli):
     ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\nwings=2\n", "unknown design key"),
     ("[design\n", "not valid TOML"),
     ("[design]\nprf_hz=[1.0]\n", "platform is required"),
+    ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\n[design.processor]\nlens=1\n",
+     "unknown [design.processor] key"),
     ("[radar]\n", "no [design] table"),
 ])
 def test_cli_bad_input_one_line(cli, tmp_path, text, msg):
