@@ -97,13 +97,14 @@ def _scene():
 def section_estimators(out: dict, raw) -> str:
     from sarcli.doppler.api import estimate_doppler
     from sarcli.doppler.cde import block_correlation
-    from sarcli.doppler.rangecomp import range_compress_valid
+    from sarcli.doppler.rangecomp import range_compress_extended
 
     tf, tr = raw.truth["doppler_centroid_hz"], raw.truth["doppler_rate_hz_per_s"]
     rho, prf = raw.slant_range(), raw.radar.prf_hz
     timers = {"cde": lambda: block_correlation(raw.echo, 2048, 128),
               "sde": lambda: block_correlation(raw.echo, 2048, 128, "sde"),
-              "rc-cde": lambda: block_correlation(range_compress_valid(raw.echo, raw.radar, raw.replica)[0], 2048, 128)}
+              "rc-cde": lambda: block_correlation(range_compress_extended(raw.echo, raw.radar, raw.replica)[0],
+                                                          2048, 128)}
     rows, data = [], []
     for est in ("cde", "sde", "rc-cde"):
         m = estimate_doppler(raw, estimator=est)

@@ -1,8 +1,12 @@
 """Range-compressed data and range sub-looks for the Doppler estimators (RC-CDE, MLCC, MLBF, map-drift).
 
 The matched filter is focus's (``sarcli.focus.rangecomp.range_filter``: replica or nominal chirp,
-compressed peak of a point on the sample of its two-way time 2R/c). Only the samples whose whole
-pulse lies inside the window are kept (``valid``: n_ref//2 .. n - n_ref//2). Range sub-looks split the
+compressed peak of a point on the sample of its two-way time 2R/c). ``range_compress_valid`` keeps only
+the samples whose whole pulse lies inside the window (n_ref//2 .. n - n_ref//2: full range resolution,
+for map-drift and the sub-looks). ``range_compress_extended`` keeps every sample any recorded echo
+reaches (-n_ref//2 .. n + n_ref//2): a point whose echo is cut by the window edge is only partially
+compressed (coarser range resolution, less energy) but its azimuth phase history is intact, so the
+RC-CDE sees the same scatterers as the raw-data CDE. Range sub-looks split the
 compressed range spectrum into two halves of the chirp band; their centre frequencies are the
 amplitude-weighted means of a point target's compressed spectrum |REF(f)|^2.
 """
@@ -23,7 +27,9 @@ def _spectrum(echo: np.ndarray, radar: Radar, replica: np.ndarray | None):
     if nref >= n:
         raise SarcliError(f"range extent ({n} samples) is not longer than the pulse ({nref} samples): "
                           "cannot range-compress")
-    nfft = sfft.next_fast_len(n + nref - 1)
+    # n + nref samples: the linear correlation (n + nref - 1) plus one, so that the partial points
+    # before the window (negative samples, wrapped to the end) never meet those after it
+    nfft = sfft.next_fast_len(n + nref)
     H, f = range_filter(radar, nfft, "rect", replica)
     S = sfft.fft(np.asarray(echo, np.complex64), nfft, axis=1, workers=-1)
     S *= H.astype(np.complex64)[None, :]
@@ -37,6 +43,18 @@ def range_compress_valid(echo: np.ndarray, radar: Radar, replica: np.ndarray | N
     S, _, _, valid = _spectrum(echo, radar, replica)
     out = sfft.ifft(S, axis=1, workers=-1)[:, valid]
     return out.astype(np.complex64), valid
+
+
+def range_compress_extended(echo: np.ndarray, radar: Radar, replica: np.ndarray | None = None
+                            ) -> tuple[np.ndarray, slice]:
+    """Range-compressed echo over every sample a recorded echo reaches, including the partially
+    compressed points at both window edges: (array complex64 with n + 2 (n_ref//2) samples, slice of
+    their raw-sample indices, starting at -(n_ref//2))."""
+    S, _, _, valid = _spectrum(echo, radar, replica)
+    n, half = echo.shape[1], valid.start
+    out = sfft.ifft(S, axis=1, workers=-1)
+    idx = np.arange(-half, n + half) % out.shape[1]  # negative samples wrapped to the end of the FFT
+    return out[:, idx].astype(np.complex64), slice(-half, n + half)
 
 
 def range_looks(echo: np.ndarray, radar: Radar, replica: np.ndarray | None = None

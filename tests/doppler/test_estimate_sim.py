@@ -36,17 +36,18 @@ def big_raw():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("estimator,bar", [("cde", 0.005), ("sde", 0.005), ("rc-cde", 0.01)])
-def test_accuracy_bars_on_clutter_scene(big_raw, estimator, bar):
+@pytest.mark.parametrize("estimator", ["cde", "sde", "rc-cde"])
+def test_accuracy_bars_on_clutter_scene(big_raw, estimator):
     """fdc RMS error < 0.5 % PRF over every range sample, fr relative error < 0.05 %, every block's
     ambiguity right. Clutter of three contrasts (land, bright strip, sea), antenna pattern, noise,
-    earth rotation, Radarsat-1 pitch/yaw limits. (rc-cde keeps only the 222 fully compressed samples
-    of this narrow 384-sample swath: 1 % bar, measured 0.58 %.)"""
+    earth rotation, Radarsat-1 pitch/yaw limits. (rc-cde correlates the extended compression, partial
+    echoes at the window edges included: restricted to the 222 fully compressed samples of this
+    narrow 384-sample swath it measured 0.58 %.)"""
     raw = big_raw
     tf, tr, rho = _truth(raw)
     m = estimate_doppler(raw, estimator=estimator)
     err = m.fdc(rho, 0.0) - tf
-    assert np.sqrt(np.mean(err**2)) < bar * raw.radar.prf_hz
+    assert np.sqrt(np.mean(err**2)) < 0.005 * raw.radar.prf_hz
     assert np.max(np.abs(m.fr(rho, 0.0) / tr - 1.0)) < 5e-4
     n_true, _ = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)
