@@ -216,30 +216,57 @@ def section_hermite(out: dict, raw) -> str:
             + markdown_table(["nodes", "fdc max error (Hz)", "fr max rel. error", "interpolation (ns per time)"], rows))
 
 
+def _stability(raw, estimator: str, gain_steps: str) -> dict:
+    """512- vs 1536-line baseband centroids per 128-sample range block, through estimate_doppler."""
+    from sarcli.doppler.api import estimate_doppler
+
+    prf = raw.radar.prf_hz
+    t0 = time.perf_counter()
+    m5 = estimate_doppler(raw, az_block=512, estimator=estimator, gain_steps=gain_steps)
+    t5 = time.perf_counter() - t0
+    m15 = estimate_doppler(raw, az_block=1536, estimator=estimator, gain_steps=gain_steps)
+    f5, f15 = m5.blocks["fdc_baseband_hz"].reshape(3, -1), m15.blocks["fdc_baseband_hz"].reshape(1, -1)
+    q5, q15 = m5.blocks["quality"].reshape(3, -1), m15.blocks["quality"].reshape(1, -1)
+    v5, v15 = m5.blocks["valid"].reshape(3, -1), m15.blocks["valid"].reshape(1, -1)
+    d = np.mod(f5 - f15 + prf / 2, prf) - prf / 2
+    good = (q15 >= np.median(q15)) & (q5 >= 0.2) & v5 & v15
+    res = {"diff_hz": d, "good": good, "quality_1536": q15[0], "baseband_1536_hz": f15[0], "t_512_s": t5,
+           "scene_baseband_hz": m15.summary["fdc_baseband_hz"], "fdc_hz": m15.summary["fdc_hz"],
+           "within_10hz_fraction": float(np.mean(np.abs(d[good]) < 10.0)) if np.any(good) else float("nan"),
+           "n_good": int(good.sum()), "gain_steps": m15.summary.get("gain_steps")}
+    if estimator == "lb":
+        s5 = np.array(m5.summary["look_balance"]["sigma_hz"])
+        s15 = np.array(m15.summary["look_balance"]["sigma_hz"])
+        res["sigma_diff_hz"] = np.hypot(s5, s15)
+    return res
+
+
 def section_real(out: dict) -> str:
     mat, par = SHARED / "rs1_vancouver_block1.mat", SHARED / "rs1_vancouver_run_params.mat"
     if not mat.exists():
         return "## F. Real data\n\n../shared/data not available in this run.\n"
     from sarcli.doppler.api import estimate_doppler
-    from sarcli.doppler.cde import block_correlation
     from sarcli.io.matlab import read_matlab_block
 
     raw = read_matlab_block(mat, par)
-    prf = raw.radar.prf_hz
-    b15 = block_correlation(raw.echo, 1536, 128)
-    b5 = block_correlation(raw.echo, 512, 128)
-    f15, q15 = b15.baseband(prf)[0], b15.quality()[0]
-    f5, q5 = b5.baseband(prf), b5.quality()
-    d = np.mod(f5 - f15[None, :] + prf / 2, prf) - prf / 2
-    good = (q15 >= np.median(q15))[None, :] & (q5 >= 0.2)
-    rows = [[j, f15[j], q15[j], *(d[i, j] for i in range(3)), *(q5[i, j] for i in range(3))] for j in range(f15.size)]
+    variants = {"CDE, raw 4-bit levels": _stability(raw, "cde", "off"),
+                "CDE, gain steps undone (default)": _stability(raw, "cde", "auto"),
+                "LB (look balance), gain steps undone": _stability(raw, "lb", "auto")}
+    base = variants["CDE, gain steps undone (default)"]
+    rows = [[j, base["baseband_1536_hz"][j], base["quality_1536"][j],
+             *(v["diff_hz"][i, j] for v in variants.values() for i in range(3))]
+            for j in range(base["diff_hz"].shape[1])]
+    lb = variants["LB (look balance), gain steps undone"]
+    lb_rows = [[j, *(lb["diff_hz"][i, j] for i in range(3)), *(lb["sigma_diff_hz"][i, j] for i in range(3))]
+               for j in range(lb["diff_hz"].shape[1])]
     t0 = time.perf_counter()
     m = estimate_doppler(raw, az_block=1536)
     t_est = time.perf_counter() - t0
     s = m.summary
-    frac = float(np.mean(np.abs(d[good]) < 10.0)) if np.any(good) else float("nan")
-    out["real"] = {"baseband_hz": f15, "quality": q15, "diff_512_minus_1536_hz": d, "quality_512": q5,
-                   "good_within_10hz_fraction": frac, "n_good": int(good.sum()), "summary": s, "t_estimate_s": t_est}
+    out["real"] = {"variants": variants, "summary": s, "t_estimate_s": t_est}
+    summary_rows = [[k, v["scene_baseband_hz"], v["fdc_hz"], v["n_good"], 100 * v["within_10hz_fraction"],
+                     float(np.median(np.abs(v["diff_hz"][v["good"]]))) if v["n_good"] else float("nan"), v["t_512_s"]]
+                    for k, v in variants.items()]
     do = s["data_only"]
     lines = "\n".join(f"- {e['method'].upper()}: fdc {e['fdc_hz']:.0f} +- {e['sigma_hz']:.0f} Hz -> ambiguity "
                       f"{e['ambiguity']}, confidence {e['confidence']:.2f}" for e in do)
@@ -250,17 +277,48 @@ def section_real(out: dict) -> str:
     mdl += (f". One effective velocity Vr = {md['velocity_mps']:.1f} +- {md['velocity_sigma_mps']:.1f} m/s: fr = "
             f"{float(m.fr(rho[0], s['scene_time_s'])):.1f} Hz/s at the near edge ({rho[0] / 1e3:.2f} km) to "
             f"{float(m.fr(rho[-1], s['scene_time_s'])):.1f} Hz/s at the far edge ({rho[-1] / 1e3:.2f} km)")
+    steps = base["gain_steps"] or []
     return ("## F. Real data: Vancouver block (1536 x 2048, RADARSAT-1 fine beam)\n\n"
-            + f"Scene baseband centroid {s['fdc_baseband_hz']:.1f} Hz (quality {s['quality']:.3f}).\n\n"
-            + markdown_table(["range block (128 samples)", "fdc_bb 1536 lines (Hz)", "quality",
-                              "512-line block 1 minus 1536 (Hz)", "block 2", "block 3", "q 512 #1", "q #2", "q #3"],
-                             rows)
-            + f"\n512 vs 1536 lines: {frac * 100:.0f} % of the {int(good.sum())} good (range block quality >= median, "
-              "512-line quality >= 0.2) block pairs within 10 Hz.\n\n"
-            + f"Data-only ambiguity: {s['ambiguity']} (confidence {s['ambiguity_confidence']:.2f}, absolute fdc "
+            + f"Receiver-gain steps found in the echo (line, dB): {', '.join(f'{a} {b:+.2f}' for a, b in steps)}.\n\n"
+            + markdown_table(["variant", "scene fdc_bb 1536 (Hz)", "fdc (Hz)", "good pairs", "within 10 Hz (%)",
+                              "median abs diff, good (Hz)", "512-line run (s)"], summary_rows)
+            + "\nGood pair: 1536-line quality >= median, 512-line quality >= 0.2, both blocks valid.\n\n"
+            + markdown_table(["range block", "fdc_bb 1536 (Hz)", "quality",
+                              *(f"{k.split(',')[0] if 'LB' in k else k}: 512 #{i + 1} - 1536" for k in variants
+                                for i in range(3))], rows)
+            + "\nLook balance: differences and their standard errors (from the blocks' sigma):\n\n"
+            + markdown_table(["range block", "diff #1", "diff #2", "diff #3", "sigma #1", "sigma #2", "sigma #3"],
+                             lb_rows)
+            + f"\nData-only ambiguity: {s['ambiguity']} (confidence {s['ambiguity_confidence']:.2f}, absolute fdc "
               f"{s['fdc_hz']:.0f} Hz at the scene centre)\n\n{lines}\n\n"
             + f"Data-driven Doppler rate (map-drift): {mdl}; scene value {s['fr_hz_per_s']:.1f} Hz/s at "
               f"{s['scene_range_m'] / 1e3:.1f} km. estimate_doppler took {t_est:.1f} s.\n")
+
+
+def section_contrast(out: dict) -> str:
+    """CDE vs look balance on the simulated coast, 512-line blocks, against the truth."""
+    from sarcli.doppler.api import estimate_doppler
+    from tests.doppler.conftest import SCENES, simulate_text
+
+    raw = simulate_text((SCENES / "rs1_coast.toml").read_text())
+    tf, rho, prf = raw.truth["doppler_centroid_hz"], raw.slant_range(), raw.radar.prf_hz
+    rows, data = [], {}
+    for est in ("cde", "lb"):
+        for az in (512, 1536):
+            t0 = time.perf_counter()
+            m = estimate_doppler(raw, estimator=est, az_block=az, rg_block=128)
+            t = time.perf_counter() - t0
+            b = m.blocks
+            err = b["fdc_hz"] - np.interp(b["range_m"], rho, tf)
+            ok = b["valid"]
+            rms = float(np.sqrt(np.mean((m.fdc(rho, 0.0) - tf) ** 2)))
+            rows.append([est, az, float(np.max(np.abs(err[ok]))), float(np.sqrt(np.mean(err[ok] ** 2))),
+                         100 * rms / prf, int(ok.sum()), int(ok.size), t])
+            data[f"{est}_{az}"] = {"block_err_hz": err, "valid": ok, "fit_rms_pct_prf": 100 * rms / prf, "t_s": t}
+    out["contrast"] = data
+    return ("## H. Scene contrast: simulated coast (tests/doppler/scenes/rs1_coast.toml, 1536 x 256, orbit)\n\n"
+            + markdown_table(["estimator", "az block", "max |block error| (Hz)", "block RMS (Hz)",
+                              "fitted scene RMS (% PRF)", "valid blocks", "blocks", "time (s)"], rows) + "\n")
 
 
 def section_examples(out: dict) -> str:
@@ -322,7 +380,7 @@ def main() -> None:
     parts = [section_throughput(out), section_blocks(out)]
     raw = _scene()
     parts += [section_estimators(out, raw), section_models(out, raw), section_hermite(out, raw), section_real(out),
-              section_examples(out)]
+              section_contrast(out), section_examples(out)]
     RESULTS.mkdir(parents=True, exist_ok=True)
     _plot(out)
     write_results("bench_doppler", "# Doppler benchmark\n\n" + "\n".join(parts) + "\nPlot: bench_doppler.png\n",

@@ -39,7 +39,8 @@ from sarcli.errors import SarcliError
 from sarcli.io.raw import RawProduct
 
 C = 299792458.0
-ESTIMATORS = ("cde", "sde", "rc-cde")
+ESTIMATORS = ("cde", "sde", "rc-cde", "lb")
+GAIN_STEP_MODES = ("auto", "on", "off")
 AMBIGUITY_MODES = ("auto", "orbit", "data", "none")
 FR_METHODS = ("auto", "orbit", "seed", "mapdrift")
 FDC_MODELS = ("vector", "closed")
@@ -78,7 +79,9 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                      half_tolerance: float = 0.02, orbit_sigma_hz: float = 140.0, noise_sigmas: float = 5.0,
                      min_quality: float = 0.02, outlier_sigma: float = 4.0, velocity_guess_mps: float = 7000.0,
                      mapdrift_segments: int = 4, dataonly_rg_block: int | None = None,
-                     max_lines: int = 4096, progress: Callable[[str], None] | None = None) -> DopplerModel:
+                     max_lines: int = 4096, gain_steps: str = "auto", lb_band_fraction: float = 0.6,
+                     progress: Callable[[str], None] | None = None,
+                     _look_balance: tuple | None = None) -> DopplerModel:
     """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
 
     ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
@@ -86,20 +89,36 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     it sets the orbit route's ambiguity confidence together with the block scatter. The data-only
     ambiguity and map-drift work on the central ``max_lines`` lines (bounded memory on full scenes).
     ``progress(stage)`` is called after each of the 5 stages (for a progress bar).
+
+    ``gain_steps``: "auto" recovers receiver-gain steps from the echo (``agcsteps``) when the product is
+    quantized and records no AGC, "on" always, "off" never. ``estimator="lb"`` runs the CDE pipeline
+    first (for the Doppler rate and the starting centroid), then replaces every block's baseband
+    centroid by the look-balance estimate (``lookbalance``, band ``lb_band_fraction`` x PRF) and runs
+    the ambiguity, fit and rate stages again on it.
     """
     def step(stage: str) -> None:
         if progress is not None:
             progress(stage)
 
     for name, val, allowed in (("estimator", estimator, ESTIMATORS), ("ambiguity", ambiguity, AMBIGUITY_MODES),
-                               ("fr_method", fr_method, FR_METHODS), ("fdc_model", fdc_model, FDC_MODELS)):
+                               ("fr_method", fr_method, FR_METHODS), ("fdc_model", fdc_model, FDC_MODELS),
+                               ("gain_steps", gain_steps, GAIN_STEP_MODES)):
         if val not in allowed:
             raise SarcliError(f"unknown {name} {val!r}; choose one of {', '.join(allowed)}")
+    if not 0.1 <= lb_band_fraction <= 0.9:
+        raise SarcliError(f"look-balance band fraction must be in [0.1, 0.9], got {lb_band_fraction}")
     if az_block < 2 or rg_block < 1:
         raise SarcliError(f"block size must be at least 2 lines x 1 sample, got {az_block} x {rg_block}")
     # the AGC changes line by line as bright targets cross the beam: left in, it re-weights the azimuth
     # spectrum asymmetrically (20 Hz on samples/rs1_point.toml)
     raw = raw.calibrated()
+    steps = None
+    if gain_steps == "on" or (gain_steps == "auto" and raw.agc_db is None and raw.radar.quantization_bits > 0):
+        from sarcli.doppler.agcsteps import detect_gain_steps, undo_gain_steps
+
+        steps = detect_gain_steps(raw.echo)
+        if steps.lines.size:
+            raw = dataclasses.replace(raw, echo=undo_gain_steps(raw.echo, steps))
     radar = raw.radar
     prf, lam = radar.prf_hz, radar.wavelength_m
     n_lines, n_samples = raw.echo.shape
@@ -114,7 +133,10 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                                   height_m=height_m, half_tolerance=half_tolerance, orbit_sigma_hz=orbit_sigma_hz,
                                   noise_sigmas=noise_sigmas, min_quality=min_quality, outlier_sigma=outlier_sigma,
                                   velocity_guess_mps=velocity_guess_mps, mapdrift_segments=mapdrift_segments,
-                                  dataonly_rg_block=dataonly_rg_block, max_lines=max_lines)
+                                  dataonly_rg_block=dataonly_rg_block, max_lines=max_lines,
+                                  gain_steps=gain_steps, lb_band_fraction=lb_band_fraction)
+    if estimator == "lb" and _look_balance is None:
+        return _two_pass_look_balance(raw, params, progress, steps)
 
     # 1. baseband centroid per block
     data, s_off = _data_for(raw, estimator)
@@ -123,6 +145,12 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     q = bc.quality()
     valid = bc.valid(noise_sigmas, min_quality)
     w = bc.weight(noise_sigmas, min_quality)
+    lb_info: dict[str, Any] = {}
+    if _look_balance is not None:  # second pass of estimator "lb": its centroids and weights
+        lb, lb_info = _look_balance
+        valid = valid & lb.valid()
+        fbb = np.where(valid, lb.fbb_hz, fbb)
+        w = np.where(valid, lb.phase_weight(prf), 0.0)
     lc, sc = bc.centres()
     t_blk = np.interp(lc, np.arange(n_lines), raw.azimuth_time)
     r_blk = radar.first_range_m + (sc + s_off) * C / (2.0 * radar.range_sampling_rate_hz)
@@ -134,6 +162,9 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     if estimator == "sde":
         sum_corr = np.sum(np.where(valid, bc.phase_rho() * bc.pairs, 0))
     fbb_scene = float(wrap_frequency(prf * np.angle(sum_corr) / (2 * np.pi), prf))
+    if _look_balance is not None:  # inverse-variance circular mean of the look-balance blocks
+        fbb_scene = float(wrap_frequency(prf * np.angle(np.sum(w * np.exp(2j * np.pi * fbb / prf))) / (2 * np.pi),
+                                         prf))
 
     step("baseband centroid")
 
@@ -273,7 +304,8 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         fdc_model=fdc_model if geo else None, fr_method=fmethod, n_blocks=int(fbb.size),
         n_az_blocks=int(fbb.shape[0]), n_rg_blocks=int(fbb.shape[1]), n_valid_blocks=int(valid.sum()),
         n_outlier_blocks=int(outl.sum()), data_only=[e.as_dict() for e in data_only], fr_info=fr_info,
-        geometry=geo_cmp, fit=fit_info)
+        geometry=geo_cmp, fit=fit_info, gain_steps=steps.as_list() if steps is not None else None,
+        look_balance=lb_info or None)
     blocks = {
         "range_m": Rg.ravel(), "azimuth_time_s": T.ravel(), "fdc_baseband_hz": fbb.ravel(), "quality": q.ravel(),
         "weight": w.ravel(), "valid": valid.ravel(), "ambiguity": res.block_ambiguity.ravel(),
@@ -284,6 +316,34 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     }
     step("summary")
     return DopplerModel(fdc_poly, fr_poly, prf, lam, blocks, summary, params)
+
+
+def _two_pass_look_balance(raw: RawProduct, params: dict[str, Any], progress, steps) -> DopplerModel:
+    """Estimator "lb": CDE pipeline, look balance per block started from the CDE's range-block centroids
+    with the first pass's Doppler rate at the scene-centre time, then the pipeline again on it."""
+    from sarcli.doppler.cde import combine
+    from sarcli.doppler.lookbalance import look_balance
+
+    opts = {k: (tuple(v) if isinstance(v, list) else v) for k, v in params.items()}
+    first = estimate_doppler(raw, **{**opts, "estimator": "cde", "gain_steps": "off"})
+    radar = raw.radar
+    bc = block_correlation(raw.echo, opts["az_block"], opts["rg_block"])
+    r_blk = radar.first_range_m + (bc.sample0 + 0.5 * (bc.n_samples - 1)) * C / (2.0 * radar.range_sampling_rate_hz)
+    t_c = float(0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1]))
+    ka = np.asarray(first.fr(r_blk, np.full_like(r_blk, t_c)), float)
+    lb = look_balance(raw.echo, radar.prf_hz, bc.line0, bc.n_lines, bc.sample0, bc.n_samples,
+                      combine(bc, 0).baseband(radar.prf_hz)[0], ka, opts["lb_band_fraction"])
+    if not np.any(lb.valid()):
+        raise SarcliError(f"look balance: no block owns {lb.margin_lines.max()}+ lines away from the scene ends "
+                          f"(scene {raw.echo.shape[0]} lines); use a longer scene, a smaller --lb-band or "
+                          "the CDE")
+    info = {"band_fraction": opts["lb_band_fraction"], "margin_lines": lb.margin_lines.tolist(),
+            "sigma_hz": lb.sigma_hz.tolist(), "pixels": lb.pixels.tolist(),
+            "cde_fdc_baseband_hz": first.summary["fdc_baseband_hz"]}
+    model = estimate_doppler(raw, **{**opts, "gain_steps": "off"}, progress=progress, _look_balance=(lb, info))
+    model.summary["gain_steps"] = steps.as_list() if steps is not None else None  # found before the passes
+    model.parameters["gain_steps"] = params["gain_steps"]
+    return model
 
 
 def _model_grid(raw: RawProduct, n_r: int = 24, n_t: int = 8) -> tuple[np.ndarray, np.ndarray]:

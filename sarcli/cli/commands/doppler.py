@@ -28,7 +28,13 @@ def doppler(
     output: Path = typer.Option(None, "-o", "--output", help="Doppler product to write (default: none)."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary and the block table as JSON."),
     plot: Path = typer.Option(None, "--plot", help="PNG of fdc and fr against range and azimuth."),
-    estimator: str = typer.Option("cde", "--estimator", help="cde | sde | rc-cde (CDE after range compression)."),
+    estimator: str = typer.Option("cde", "--estimator",
+                                  help="cde | sde | rc-cde (CDE after range compression) | lb (look balance on "
+                                       "the focused scene: robust to scene contrast, needs > 2 look apertures)."),
+    gain_steps: str = typer.Option("auto", "--gain-steps",
+                                   help="Receiver-gain steps recovered from the echo and undone: auto (quantized "
+                                        "products without AGC records) | on | off."),
+    lb_band: float = typer.Option(0.6, "--lb-band", help="Look-balance processed band, fraction of the PRF."),
     az_block: int = typer.Option(2048, "--az-block", help="Azimuth lines per block (seed: 2048)."),
     rg_block: int = typer.Option(128, "--rg-block", help="Range samples per block (seed: 128)."),
     ambiguity: str = typer.Option("auto", "--ambiguity",
@@ -55,6 +61,8 @@ def doppler(
       sarcli doppler raw.h5 --json --plot doppler.png
 
       sarcli doppler vancouver.h5 --ambiguity data --az-block 1536 --json
+
+      sarcli doppler vancouver.h5 --estimator lb --az-block 512
     """
     from sarcli.doppler.api import estimate_doppler
     from sarcli.io.doppler_product import write_doppler
@@ -66,7 +74,8 @@ def doppler(
         model = estimate_doppler(raw, az_block=az_block, rg_block=rg_block, estimator=estimator,
                                  ambiguity=ambiguity, ambiguity_value=ambiguity_value, fr_method=fr_method,
                                  fdc_model=fdc_model, fit_degree=degrees, n_nodes=n_nodes,
-                                 exact_attitude=not small_angle, progress=lambda _stage: bar.update(1))
+                                 exact_attitude=not small_angle, gain_steps=gain_steps, lb_band_fraction=lb_band,
+                                 progress=lambda _stage: bar.update(1))
     if output is not None:
         write_doppler(output, model, inputs=(raw_path,))
     if plot is not None:
@@ -78,6 +87,9 @@ def doppler(
          f"[{s['ambiguity_source']}, confidence {s['ambiguity_confidence']:.3f}, margin "
          f"{s['ambiguity_margin_prf']:.3f} PRF]; fr {s['fr_hz_per_s']:.3f} Hz/s [{s['fr_method']}]; "
          f"{s['n_valid_blocks']}/{s['n_blocks']} blocks valid, {s['n_outlier_blocks']} flagged", quiet or as_json)
+    if s.get("gain_steps"):
+        info(f"undid {len(s['gain_steps'])} receiver-gain step(s) found in the echo (line, dB): "
+             + ", ".join(f"{m} {d:+.2f}" for m, d in s["gain_steps"]), quiet or as_json)
     if as_json:
         out = dict(s)
         out["output"] = str(output) if output is not None else None
