@@ -94,9 +94,12 @@ def step_size(p: np.ndarray, m: int, lo: int, hi: int) -> float:
 
 def detect_gain_steps(echo: np.ndarray, w: int = 16, min_step_db: float = 0.25, n_sigma: float = 6.0,
                       n_jump: float = 3.0, group_samples: int = 256, size_lines: int = 64) -> GainSteps:
-    """Gain steps of ``echo`` (module docstring). Detection uses +-``w`` lines; each accepted step's size
-    is then fitted over up to ``size_lines`` lines on either side, bounded by its neighbouring steps."""
+    """Gain steps of ``echo`` (module docstring). Detection uses +-``w`` lines (none in an echo shorter
+    than 2 w lines); each accepted step's size is then fitted over up to ``size_lines`` lines on either
+    side, bounded by its neighbouring steps."""
     p = line_power_db(echo)
+    if p.size < 2 * w:
+        return GainSteps(np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 1)), np.zeros(1, np.int64))
     d, sd = step_statistic(p, w)
     jump = np.diff(p, prepend=p[0])
     dj = np.diff(p)

@@ -105,15 +105,16 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                                ("gain_steps", gain_steps, GAIN_STEP_MODES)):
         if val not in allowed:
             raise SarcliError(f"unknown {name} {val!r}; choose one of {', '.join(allowed)}")
-    if not 0.1 <= lb_band_fraction <= 0.9:
+    if estimator == "lb" and not 0.1 <= lb_band_fraction <= 0.9:
         raise SarcliError(f"look-balance band fraction must be in [0.1, 0.9], got {lb_band_fraction}")
     if az_block < 2 or rg_block < 1:
         raise SarcliError(f"block size must be at least 2 lines x 1 sample, got {az_block} x {rg_block}")
     # the AGC changes line by line as bright targets cross the beam: left in, it re-weights the azimuth
     # spectrum asymmetrically (20 Hz on samples/rs1_point.toml)
+    has_agc = raw.agc_db is not None
     raw = raw.calibrated()
     steps = None
-    if gain_steps == "on" or (gain_steps == "auto" and raw.agc_db is None and raw.radar.quantization_bits > 0):
+    if gain_steps == "on" or (gain_steps == "auto" and not has_agc and raw.radar.quantization_bits > 0):
         from sarcli.doppler.agcsteps import detect_gain_steps, undo_gain_steps
 
         steps = detect_gain_steps(raw.echo)
@@ -146,15 +147,17 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
     valid = bc.valid(noise_sigmas, min_quality)
     w = bc.weight(noise_sigmas, min_quality)
     lb_info: dict[str, Any] = {}
-    if _look_balance is not None:  # second pass of estimator "lb": its centroids and weights
+    if _look_balance is not None:  # second pass of estimator "lb": its centroids, weights and times
         lb, lb_info = _look_balance
-        valid = valid & lb.valid()
+        valid = valid & lb.valid()  # the CDE's noise-floor test stays: LB alone cannot tell noise
         fbb = np.where(valid, lb.fbb_hz, fbb)
         w = np.where(valid, lb.phase_weight(prf), 0.0)
     lc, sc = bc.centres()
     t_blk = np.interp(lc, np.arange(n_lines), raw.azimuth_time)
     r_blk = radar.first_range_m + (sc + s_off) * C / (2.0 * radar.range_sampling_rate_hz)
     T, Rg = np.meshgrid(t_blk, r_blk, indexing="ij")
+    if _look_balance is not None:  # a look-balance block is at the centre of the pixels it used
+        T = np.where(valid, np.interp(lb.centre_line, np.arange(n_lines), raw.azimuth_time), T)
     if not np.any(valid):
         raise SarcliError("no block has a usable Doppler signal (all blocks are noise or zero); "
                           "try larger blocks (--az-block/--rg-block)")
@@ -334,9 +337,9 @@ def _two_pass_look_balance(raw: RawProduct, params: dict[str, Any], progress, st
     lb = look_balance(raw.echo, radar.prf_hz, bc.line0, bc.n_lines, bc.sample0, bc.n_samples,
                       combine(bc, 0).baseband(radar.prf_hz)[0], ka, opts["lb_band_fraction"])
     if not np.any(lb.valid()):
-        raise SarcliError(f"look balance: no block owns {lb.margin_lines.max()}+ lines away from the scene ends "
-                          f"(scene {raw.echo.shape[0]} lines); use a longer scene, a smaller --lb-band or "
-                          "the CDE")
+        raise SarcliError(f"look balance: no block owns 32+ lines farther than {lb.margin_lines.max()} lines from "
+                          f"the scene ends (scene {raw.echo.shape[0]} lines, blocks of {opts['az_block']}); use a "
+                          "longer scene or larger --az-block, a smaller --lb-band, or the CDE")
     info = {"band_fraction": opts["lb_band_fraction"], "margin_lines": lb.margin_lines.tolist(),
             "sigma_hz": lb.sigma_hz.tolist(), "pixels": lb.pixels.tolist(),
             "cde_fdc_baseband_hz": first.summary["fdc_baseband_hz"]}

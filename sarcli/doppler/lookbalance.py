@@ -28,10 +28,12 @@ block by -16 Hz without the guard, +9 Hz with it; sigma 6 Hz). So a block's esti
 the lines around it (each target's whole look aperture) but only the targets inside it.
 
 How. Per range block one azimuth FFT; per azimuth block the root of D is bracketed by steps of 5 %
-PRF from the CDE's centroid (D decreases over tens of Hz, but is rough below ~1 Hz: bins of speckled
-power enter and leave the looks, which defeats Newton steps) and found by Brent's method to
-``tol_hz``; look edges weight their cut bins by the fraction inside, so D is continuous. A block without
-a sign change within ``max_iter`` steps, or with a non-negative slope at its root, is invalid. The
+PRF from the start value (the pipeline passes the CDE centroid of the range block over the whole
+scene) and found by Brent's method to ``tol_hz``. D decreases over tens of Hz but is rough below
+~1 Hz (bins of speckled power enter and leave the looks), which defeats Newton steps; look edges weight
+their cut bins by the fraction inside, so D is at least continuous. ``step_hz`` is only the
+finite-difference step of the slope at the root. A block without a sign change within ``max_iter``
+steps, or with a non-negative slope at its root, is invalid. The
 standard error of a block comes from the scatter of -D/D' over ``n_groups`` contiguous groups of its
 pixels (targets in different groups are independent; raw range columns are not, a pulse spans them
 all).
@@ -55,13 +57,20 @@ from sarcli.errors import SarcliError
 
 @dataclass
 class LookBalance:
-    """Per (azimuth block, range block): baseband centroid ``fbb_hz`` ([-PRF/2, PRF/2), NaN when the
-    block owns too few usable pixels or D has no usable slope), its standard error ``sigma_hz``,
-    ``pixels`` (owned lines used) and the slope ``slope_per_hz`` dD/df_ref; ``margin_lines`` is L."""
+    """Per (azimuth block, range block): baseband centroid ``fbb_hz`` ([-PRF/2, PRF/2); NaN when the
+    block owns too few usable pixels, no sign change of D is found within ``max_iter`` bracketing steps,
+    or D has no negative slope at the root), its standard error ``sigma_hz``, ``pixels`` (owned lines
+    used), ``centre_line`` (mean of those lines, where the estimate applies) and the slope
+    ``slope_per_hz`` dD/df_ref; ``margin_lines`` is L per range block.
+
+    The standard error describes the scatter of targets, not whether there is signal at all: a block of
+    pure noise can keep a root with a modest sigma. The pipeline therefore keeps only blocks that the
+    CDE's noise-floor test accepts (``estimate_doppler``)."""
 
     fbb_hz: np.ndarray
     sigma_hz: np.ndarray
     pixels: np.ndarray
+    centre_line: np.ndarray
     slope_per_hz: np.ndarray
     margin_lines: np.ndarray
 
@@ -139,7 +148,7 @@ def look_balance(echo: np.ndarray, prf: float, line0: np.ndarray, n_lines: np.nd
     band = band_fraction * prf
     max_step = 0.05 * prf  # bracketing step (D is monotonic on this scale, speckle-rough below 1 Hz)
     shape = (line0.size, sample0.size)
-    fbb, sig, slope = (np.full(shape, np.nan) for _ in range(3))
+    fbb, sig, slope, centre = (np.full(shape, np.nan) for _ in range(4))
     pix = np.zeros(shape, np.int64)
     margin = np.zeros(sample0.size, np.int64)
     for j in range(sample0.size):
@@ -148,6 +157,7 @@ def look_balance(echo: np.ndarray, prf: float, line0: np.ndarray, n_lines: np.nd
         owned = [np.arange(max(a, big_l), min(a + m, n - big_l)) for a, m in zip(line0, n_lines, strict=True)]
         ok = np.array([o.size >= max(min_pixels, 2 * n_groups) for o in owned])
         pix[:, j] = [o.size for o in owned]
+        centre[:, j] = [o.mean() if o.size else np.nan for o in owned]
         if not np.any(ok):
             continue
         spec = sfft.fft(np.asarray(echo[:, sample0[j]:sample0[j] + n_samples[j]], np.complex64), axis=0,
@@ -167,4 +177,4 @@ def look_balance(echo: np.ndarray, prf: float, line0: np.ndarray, n_lines: np.nd
             fbb[i, j] = wrap_frequency(root, prf)
             sig[i, j] = np.std(steps, ddof=1) / np.sqrt(steps.size)
             slope[i, j] = s_i
-    return LookBalance(fbb, sig, pix, slope, margin)
+    return LookBalance(fbb, sig, pix, centre, slope, margin)

@@ -74,7 +74,24 @@ def test_vancouver_steps_are_single_line_jumps_of_the_line_power(shared_data):
     assert np.mean(np.abs(s.db_groups[:, 0])) > np.mean(np.abs(s.db_groups[:, -1]))
 
 
-@pytest.mark.parametrize("bad", [0, 2])
-def test_short_or_empty_inputs_give_no_steps(bad):
-    e = np.ones((bad, 8), np.complex64) if bad else np.zeros((1, 8), np.complex64)
-    assert detect_gain_steps(e).lines.size == 0
+@pytest.mark.parametrize("shape", [(0, 8), (1, 8), (2, 8), (31, 8)])
+def test_short_or_empty_inputs_give_no_steps(shape):
+    s = detect_gain_steps(np.ones(shape, np.complex64))
+    assert s.lines.size == 0 and s.as_list() == []
+    assert undo_gain_steps(np.ones(shape, np.complex64), s).shape == shape
+
+
+def test_gain_step_modes_in_the_pipeline(clutter_raw):
+    """auto: only quantized products without an AGC record; on: always; off: never."""
+    import dataclasses
+
+    from sarcli.doppler.api import estimate_doppler
+
+    q = dataclasses.replace(clutter_raw, radar=dataclasses.replace(clutter_raw.radar, quantization_bits=4))
+    with_agc = dataclasses.replace(q, agc_db=np.zeros(q.echo.shape[0]))
+    kw = dict(az_block=512, rg_block=96)
+    assert estimate_doppler(clutter_raw, **kw).summary["gain_steps"] is None  # not quantized
+    assert estimate_doppler(q, **kw).summary["gain_steps"] == []  # searched, none in this scene
+    assert estimate_doppler(with_agc, **kw).summary["gain_steps"] is None  # the record is used instead
+    assert estimate_doppler(with_agc, gain_steps="on", **kw).summary["gain_steps"] == []
+    assert estimate_doppler(q, gain_steps="off", **kw).summary["gain_steps"] is None
