@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 from typer.testing import CliRunner
 
 REPO = Path(__file__).resolve().parents[1]
@@ -14,6 +15,12 @@ SHARED = Path(os.environ.get("SARCLI_SHARED", REPO.parent / "shared"))
 SAMPLES = REPO / "samples"
 
 os.environ.setdefault("SARCLI_NO_PROGRESS", "1")
+
+# Property tests draw the same examples on every run (a CI result does not depend on luck);
+# HYPOTHESIS_PROFILE=explore draws new ones, to hunt for failures locally.
+settings.register_profile("repeatable", derandomize=True)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
 
 
 @dataclass
