@@ -69,17 +69,16 @@ def step_statistic(p: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     sd = np.full(n, np.inf)
     if n < 2 * w or w < 3:
         return d, sd
-    t = np.arange(w, dtype=np.float64)
-    tc = t - t.mean()
+    tc = np.arange(w, dtype=np.float64) - 0.5 * (w - 1)
     sxx = 2.0 * np.sum(tc**2)
-    for m in range(w, n - w + 1):
-        left, right = p[m - w:m], p[m:m + w]
-        ml, mr = left.mean(), right.mean()
-        b = (np.sum(tc * (left - ml)) + np.sum(tc * (right - mr))) / sxx
-        d[m] = mr - ml - b * w  # the two means sit w lines apart
-        res = np.concatenate([left - ml - b * tc, right - mr - b * tc])
-        s2 = np.sum(res**2) / (2 * w - 3)
-        sd[m] = np.sqrt(s2 * (2.0 / w + w**2 / sxx))
+    win = np.lib.stride_tricks.sliding_window_view(p, 2 * w)  # row k: lines k .. k + 2w - 1, m = k + w
+    left, right = win[:, :w], win[:, w:]
+    ml, mr = left.mean(axis=1, keepdims=True), right.mean(axis=1, keepdims=True)
+    b = ((left - ml) @ tc + (right - mr) @ tc)[:, None] / sxx
+    res2 = np.sum((left - ml - b * tc) ** 2, axis=1) + np.sum((right - mr - b * tc) ** 2, axis=1)
+    m = np.arange(w, n - w + 1)
+    d[m] = (mr - ml - b * w)[:, 0]  # the two means sit w lines apart
+    sd[m] = np.sqrt(res2 / (2 * w - 3) * (2.0 / w + w**2 / sxx))
     return d, sd
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sarcli.doppler.agcsteps import detect_gain_steps, undo_gain_steps
+from sarcli.doppler.agcsteps import detect_gain_steps, step_statistic, undo_gain_steps
 from tests.doppler.synth import azimuth_process, quantize_4bit
 
 PRF = 1257.0
@@ -95,3 +95,21 @@ def test_gain_step_modes_in_the_pipeline(clutter_raw):
     assert estimate_doppler(with_agc, **kw).summary["gain_steps"] is None  # the record is used instead
     assert estimate_doppler(with_agc, gain_steps="on", **kw).summary["gain_steps"] == []
     assert estimate_doppler(q, gain_steps="off", **kw).summary["gain_steps"] is None
+
+
+def test_step_statistic_matches_a_least_squares_fit_per_line():
+    """Against numpy lstsq of p = a + b (t - m) + d [t >= m] on each window (independent of the
+    closed form the module uses)."""
+    rng = np.random.default_rng(4)
+    p = np.cumsum(rng.standard_normal(80)) * 0.1
+    p[40:] += 0.8
+    w = 6
+    d, sd = step_statistic(p, w)
+    for m in range(w, p.size - w + 1):
+        t = np.arange(m - w, m + w) - m
+        a = np.column_stack([np.ones(2 * w), t, (t >= 0).astype(float)])
+        coef, rss, *_ = np.linalg.lstsq(a, p[m - w:m + w], rcond=None)
+        cov = rss[0] / (2 * w - 3) * np.linalg.inv(a.T @ a)
+        assert d[m] == pytest.approx(coef[2], abs=1e-12)
+        assert sd[m] == pytest.approx(np.sqrt(cov[2, 2]), rel=1e-9)
+    assert np.all(d[:w] == 0) and np.all(np.isinf(sd[-w + 1:]))
