@@ -43,8 +43,8 @@ def _emulator() -> tuple[subprocess.Popen, dict]:
 
 
 def _scan(ports: dict, fmt: str, folder: Path) -> dict:
-    from sarcli.gbsar.acquire.config import load_config
-    from sarcli.gbsar.acquire.controller import connect, run_scan, scan_template
+    from sarcli.acquire.config import load_config
+    from sarcli.acquire.controller import connect, run_scan, scan_template
     from sarcli.io.scan import ScanWriter
 
     cfg = load_config(None, {
@@ -70,9 +70,10 @@ def _scan(ports: dict, fmt: str, folder: Path) -> dict:
 
 
 def _parts(folder: Path) -> list[dict]:
-    from sarcli.gbsar.acquire.emulator.vna import binary_block, form4_block
-    from sarcli.gbsar.acquire.vna8753 import parse_binary, parse_form4
-    from sarcli.io.scan import Scan, ScanWriter
+    from sarcli.acquire.emulator.vna import binary_block, form4_block
+    from sarcli.acquire.vna8753 import parse_binary, parse_form4
+    from sarcli.io.scan import ScanWriter
+    from sarcli.model.gbsar import Scan
 
     rng = np.random.default_rng(0)
     z = rng.standard_normal(POINTS) + 1j * rng.standard_normal(POINTS)

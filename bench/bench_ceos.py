@@ -33,7 +33,7 @@ BLOCK = 256  # lines per block of the numpy reference decode (bounded memory)
 def _scene(n_lines: int):
     from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
     from sarcli.io.ceos import aux as A
-    from sarcli.io.raw import Orbit, Radar, RawProduct
+    from sarcli.model.raw import Orbit, Radar, RawProduct
 
     rng = np.random.default_rng(1)
     prf = float(A.prf_from_code(4283, 0))

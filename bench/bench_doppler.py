@@ -156,7 +156,7 @@ def _mapdrift_airborne() -> dict:
 
 def section_models(out: dict, raw) -> str:
     from sarcli.doppler.geometry import OrbitGeometry
-    from sarcli.io.raw import Attitude
+    from sarcli.model.raw import Attitude
 
     rho = np.linspace(raw.slant_range()[0], raw.slant_range()[-1], 200)
     t = np.linspace(raw.azimuth_time[0], raw.azimuth_time[-1], 200)

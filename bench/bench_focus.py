@@ -34,7 +34,7 @@ C = 299792458.0
 
 
 def _rs1_raw(n_lines: int, n_samples: int, seed: int = 1):
-    from sarcli.io.raw import Radar, RawProduct
+    from sarcli.model.raw import Radar, RawProduct
 
     rng = np.random.default_rng(seed)
     echo = np.empty((n_lines, n_samples), np.complex64)
@@ -51,7 +51,7 @@ def _rs1_raw(n_lines: int, n_samples: int, seed: int = 1):
 
 
 def _doppler():
-    from sarcli.focus.doppler_models import GeometricDoppler
+    from sarcli.model.doppler import GeometricDoppler
 
     return GeometricDoppler.from_centroid_and_rate(-7044.0, -1775.0, 993.4e3, C / 5.3e9)
 

@@ -15,8 +15,8 @@ SCENE = Path(__file__).resolve().parents[1] / "samples" / "aod_ccd_scene.toml"
 
 def main() -> None:
     from sarcli.design.params import doppler_bandwidth
-    from sarcli.focus.doppler_models import GeometricDoppler
     from sarcli.focus.rda import focus_rd
+    from sarcli.model.doppler import GeometricDoppler
     from sarcli.optical import limitations as lim
     from sarcli.optical.devices import CCD, OpticalSettings
     from sarcli.optical.emulator import emulate

@@ -1,25 +1,34 @@
-"""User-facing errors.
+"""Errors a user can cause, each with a one-line message: what went wrong, where, what to do.
 
-Any mistake a user can make (bad file, bad option, impossible geometry) is raised as a
-:class:`SarcliError` whose message is one line: what went wrong, where, and what to do.
-The CLI prints it as ``sarcli: error: <message>`` and exits non-zero, never with a traceback.
+Every class is a :class:`ValueError`, so a library caller can ``except ValueError``. The exit codes
+belong to the command line only (``sarcli.cli.common.exit_code_for``): 2 for a usage or
+configuration mistake, 1 for bad data (a malformed product or file), 3 for an instrument fault,
+130 for an interruption.
 """
 
 
-class SarcliError(Exception):
+class SarcliError(ValueError):
     """An error caused by input or configuration, reported to the user in one line."""
 
-    exit_code = 2
-
-    def __init__(self, message: str, exit_code: int | None = None):
+    def __init__(self, message: str):
         super().__init__(" ".join(str(message).split()))
-        if exit_code is not None:
-            self.exit_code = exit_code
+
+
+class ConfigError(SarcliError):
+    """A bad option, configuration value or combination of them (a usage mistake)."""
 
 
 class ProductError(SarcliError):
-    """A product file is missing, malformed or of the wrong type."""
+    """A product or input file is missing, malformed, physically implausible or of the wrong type."""
 
 
-class FormatError(SarcliError):
-    """An external format (CEOS, MATLAB, TOML) could not be decoded."""
+class FormatError(ProductError):
+    """An external format (CEOS, MATLAB, TOML, Level-0 packets, ...) could not be decoded."""
+
+
+class InstrumentError(SarcliError):
+    """An instrument misbehaved (no answer after the retries, refused a command, wrong identity)."""
+
+
+class Interrupted(SarcliError):
+    """The user asked to stop (Ctrl-C); what was measured so far is kept."""

@@ -24,7 +24,7 @@ from sarcli.ati.estimate import Estimate, SlowTime, estimate
 from sarcli.ati.geometry import Mover, Platform, coefficients, range_history, stationary_history
 from sarcli.ati.slowtime import choose_bin, coregister, decompress, recompress, single_bin, track_peak
 from sarcli.errors import SarcliError
-from sarcli.io.raw import RawProduct
+from sarcli.model.raw import RawProduct
 
 BIN_MODES = ("track", "anv")
 COMPENSATIONS = ("exact", "quadratic", "conventional")
@@ -68,8 +68,8 @@ def focus_pair(raw: RawProduct, **knobs) -> Pair:
     import time
     import warnings
 
-    from sarcli.focus.doppler_models import GeometricDoppler
     from sarcli.focus.rda import focus_rd
+    from sarcli.model.doppler import GeometricDoppler
 
     plat, t_ref, origin, sign = flat_geometry(raw)
     offs = raw.radar.receiver_offsets_m

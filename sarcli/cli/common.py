@@ -13,13 +13,27 @@ import typer
 from typer.core import TyperGroup
 
 from orbit.errors import OrbitError
-from sarcli.errors import SarcliError
+from sarcli.errors import InstrumentError, Interrupted, ProductError, SarcliError
 from sarcli.io.h5common import to_jsonable
 
 T = TypeVar("T")
 
 
-def fail(message: str, exit_code: int = 2) -> typer.Exit:
+EXIT_USAGE, EXIT_DATA, EXIT_INSTRUMENT, EXIT_INTERRUPT = 2, 1, 3, 130
+
+
+def exit_code_for(error: BaseException) -> int:
+    """The exit status of an error: 130 interrupted, 3 instrument, 1 bad data, 2 usage or configuration."""
+    if isinstance(error, Interrupted | KeyboardInterrupt):
+        return EXIT_INTERRUPT
+    if isinstance(error, InstrumentError):
+        return EXIT_INSTRUMENT
+    if isinstance(error, ProductError | OrbitError | OSError):
+        return EXIT_DATA
+    return EXIT_USAGE
+
+
+def fail(message: str, exit_code: int = EXIT_USAGE) -> typer.Exit:
     """Print ``sarcli: error: message`` on stderr and return the Exit to raise."""
     typer.echo(f"sarcli: error: {message}", err=True)
     return typer.Exit(exit_code)
@@ -31,15 +45,13 @@ class SarcliGroup(TyperGroup):
     def invoke(self, ctx: typer.Context) -> Any:
         try:
             return super().invoke(ctx)
-        except SarcliError as e:
-            raise fail(str(e), e.exit_code) from None
-        except OrbitError as e:  # impossible geometry / bad state vectors from the orbit package
-            raise fail(str(e)) from None
+        except (SarcliError, OrbitError) as e:  # OrbitError: impossible geometry, bad state vectors
+            raise fail(str(e), exit_code_for(e)) from None
         except (FileNotFoundError, PermissionError, IsADirectoryError) as e:
             name = getattr(e, "filename", None)
-            raise fail(f"{name}: {e.strerror}" if name else str(e)) from None
-        except KeyboardInterrupt:
-            raise fail("interrupted", 130) from None
+            raise fail(f"{name}: {e.strerror}" if name else str(e), exit_code_for(e)) from None
+        except KeyboardInterrupt as e:
+            raise fail("interrupted", exit_code_for(e)) from None
 
 
 def make_typer(**kwargs: Any) -> typer.Typer:

@@ -35,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orbit.constants import C_LIGHT, WGS84_A
 from sarcli.errors import SarcliError
+from sarcli.model.constants import C_LIGHT, WGS84_A
 
 PLATFORMS = ("airborne", "spaceborne", "gbsar")
 

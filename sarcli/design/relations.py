@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from orbit.constants import C_LIGHT
+from sarcli.model.constants import C_LIGHT
 
 
 def chirp_bandwidth(chirp_rate_hz_per_s: float, pulse_length_s: float) -> float:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from orbit.constants import C_LIGHT
 from sarcli.design import relations as rel
 from sarcli.design.params import DesignParams
+from sarcli.model.constants import C_LIGHT
 
 
 def _constraint(name: str, ok: bool, value: float, limit: float, relation: str, note: str = "") -> dict:

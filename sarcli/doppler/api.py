@@ -1,4 +1,4 @@
-"""``estimate_doppler(raw) -> DopplerModel`` (contract 4): the seed's hybrid method, plus data-only routes.
+"""``estimate_doppler(raw) -> PolyDoppler`` (contract 4): the seed's hybrid method, plus data-only routes.
 
 Pipeline
 1. Baseband centroid per (azimuth block, range block): CDE on the raw echo (default, the seed's
@@ -33,12 +33,13 @@ import numpy as np
 from sarcli.doppler import ambiguity as amb
 from sarcli.doppler.cde import block_correlation, wrap_frequency
 from sarcli.doppler.dataonly import combine_estimates, mlbf, mlcc
-from sarcli.doppler.model import DopplerModel
-from sarcli.doppler.polyfit import Poly2D, fit_poly2d
+from sarcli.doppler.polyfit import fit_poly2d
 from sarcli.errors import SarcliError
-from sarcli.io.raw import RawProduct
+from sarcli.model.constants import C_LIGHT as C
+from sarcli.model.doppler import PolyDoppler
+from sarcli.model.poly import Poly2D
+from sarcli.model.raw import RawProduct
 
-C = 299792458.0
 ESTIMATORS = ("cde", "sde", "rc-cde", "lb")
 GAIN_STEP_MODES = ("auto", "on", "off")
 AMBIGUITY_MODES = ("auto", "orbit", "data", "none")
@@ -81,7 +82,7 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
                      mapdrift_segments: int = 4, dataonly_rg_block: int | None = None,
                      max_lines: int = 4096, gain_steps: str = "auto", lb_band_fraction: float = 0.6,
                      progress: Callable[[str], None] | None = None,
-                     _look_balance: tuple | None = None) -> DopplerModel:
+                     _look_balance: tuple | None = None) -> PolyDoppler:
     """Estimate the absolute Doppler centroid and the Doppler rate of a raw product (module docstring).
 
     ``ambiguity_value`` forces the scene ambiguity (source "user"). ``orbit_sigma_hz`` is the assumed
@@ -318,10 +319,10 @@ def estimate_doppler(raw: RawProduct, *, az_block: int = 2048, rg_block: int = 1
         "outlier": outl.ravel(),
     }
     step("summary")
-    return DopplerModel(fdc_poly, fr_poly, prf, lam, blocks, summary, params)
+    return PolyDoppler(fdc_poly, fr_poly, prf, lam, blocks, summary, params)
 
 
-def _two_pass_look_balance(raw: RawProduct, params: dict[str, Any], progress, steps) -> DopplerModel:
+def _two_pass_look_balance(raw: RawProduct, params: dict[str, Any], progress, steps) -> PolyDoppler:
     """Estimator "lb": CDE pipeline, look balance per block started from the CDE's range-block centroids
     with the first pass's Doppler rate at the scene-centre time, then the pipeline again on it."""
     from sarcli.doppler.cde import combine

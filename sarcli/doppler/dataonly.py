@@ -46,7 +46,7 @@ import numpy as np
 from sarcli.doppler.ambiguity import rounding_confidence
 from sarcli.doppler.cde import block_correlation
 from sarcli.doppler.rangecomp import range_looks
-from sarcli.io.raw import Radar
+from sarcli.model.raw import Radar
 
 
 @dataclass

@@ -46,7 +46,7 @@ from orbit.geodetic import ecef_to_geodetic
 from orbit.pointing import beam_vector, flight_frame, side_sign
 from orbit.statevectors import StateVectors
 from sarcli.errors import SarcliError
-from sarcli.io.raw import RawProduct
+from sarcli.model.raw import RawProduct
 
 
 @dataclass

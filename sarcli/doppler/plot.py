@@ -6,11 +6,11 @@ import os
 
 import numpy as np
 
-from sarcli.doppler.model import DopplerModel
 from sarcli.io.images import atomic_path
+from sarcli.model.doppler import PolyDoppler
 
 
-def plot_doppler(path: str | os.PathLike, model: DopplerModel, title: str = "") -> None:
+def plot_doppler(path: str | os.PathLike, model: PolyDoppler, title: str = "") -> None:
     """Four panels: absolute fdc vs range / vs azimuth time (blocks coloured by quality, outliers and
     invalid blocks marked, the fitted model at the scene centre), and fr vs range / vs azimuth time."""
     import matplotlib

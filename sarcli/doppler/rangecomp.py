@@ -18,7 +18,7 @@ import scipy.fft as sfft
 
 from sarcli.errors import SarcliError
 from sarcli.focus.rangecomp import chirp_band, range_filter, reference_pulse
-from sarcli.io.raw import Radar
+from sarcli.model.raw import Radar
 
 
 def _spectrum(echo: np.ndarray, radar: Radar, replica: np.ndarray | None):

@@ -20,8 +20,8 @@ from sarcli.focus.backprojection import backproject_grid
 from sarcli.focus.geolocation import platform_state, zero_doppler_points
 from sarcli.focus.rangecomp import C, compress_lines, range_filter, reference_pulse
 from sarcli.focus.rda import _plan, doppler_on_grid, make_knobs
-from sarcli.io.raw import RawProduct
-from sarcli.io.slc import SLC, DopplerUsed
+from sarcli.model.raw import RawProduct
+from sarcli.model.slc import SLC, DopplerUsed
 
 
 def focus_bp(raw: RawProduct, doppler, channel: int = 0, lines: tuple[int, int] | None = None,

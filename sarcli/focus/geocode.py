@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from sarcli.errors import SarcliError
-from sarcli.io.slc import SLC
+from sarcli.model.slc import SLC
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:

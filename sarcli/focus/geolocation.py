@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from sarcli.errors import SarcliError
-from sarcli.io.raw import Orbit
+from sarcli.model.raw import Orbit
 
 
 def state_vectors(orbit: Orbit | None, epoch_utc: str):

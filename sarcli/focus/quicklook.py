@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from sarcli.focus.geocode import multilook
-from sarcli.io.slc import SLC
+from sarcli.model.slc import SLC
 
 
 def write_slc_quicklook(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, max_pixels: int = 1600,

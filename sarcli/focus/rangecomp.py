@@ -29,9 +29,8 @@ from numba import njit
 
 from sarcli.errors import SarcliError
 from sarcli.focus.windows import window
-from sarcli.io.raw import Radar
-
-C = 299792458.0
+from sarcli.model.constants import C_LIGHT as C
+from sarcli.model.raw import Radar
 
 
 def reference_pulse(radar: Radar, replica: np.ndarray | None = None) -> np.ndarray:

@@ -56,8 +56,8 @@ from sarcli.focus.rangecomp import (
 )
 from sarcli.focus.rcmc import rcmc_azimuth
 from sarcli.focus.windows import parse_window, window_table
-from sarcli.io.raw import RawProduct
-from sarcli.io.slc import SLC, DopplerUsed
+from sarcli.model.raw import RawProduct
+from sarcli.model.slc import SLC, DopplerUsed
 
 RANGE_GUARD = 64  # range samples beyond the correlation's wrap-free length (SRC impulse response)
 CHUNK = 64  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass

@@ -7,5 +7,3 @@ Focused images live in the slant plane of the rail: azimuth ``x`` and range ``R0
 of a point from the rail line (``R0 = sqrt(y**2 + (z - h)**2)``). Phase of a scatterer at one-way
 range R at frequency f: ``exp(-j*4*pi*f*R/c)``.
 """
-
-C_LIGHT = 299_792_458.0  # m/s (the paper's rates -12729 deg/m etc. use the exact value)

@@ -22,7 +22,7 @@ from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
 from sarcli.gbsar.rangecomp import RangeProfiles, range_compress
 from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
-from sarcli.io.scan import Scan
+from sarcli.model.gbsar import Scan
 
 ALGORITHMS = ("auto", "df", "rd", "bp")
 ALG_CODE = {"df": 1, "rd": 2, "bp": 3}
@@ -201,7 +201,7 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
 def image_from_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None = None,
                     pols: tuple[str, ...] | None = None):
     """Focus ``scan`` and wrap the result as a :class:`sarcli.io.gbsar_image.GbsarImage` product."""
-    from sarcli.io.gbsar_image import GbsarImage
+    from sarcli.model.gbsar import GbsarImage
 
     opts = opts or FocusOptions()
     f = focus_scan(scan, opts, grid, pols)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarcli.errors import SarcliError
-from sarcli.io.scan import Site
+from sarcli.model.gbsar import Site
 
 
 def rail_axes(site: Site) -> tuple[np.ndarray, np.ndarray]:

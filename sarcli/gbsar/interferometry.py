@@ -38,8 +38,8 @@ import numpy as np
 from scipy.ndimage import uniform_filter
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
-from sarcli.io.gbsar_image import GbsarImage
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.gbsar import GbsarImage
 
 MODES = ("dinsar", "crosstrack", "deltaf", "combined")
 

@@ -21,9 +21,9 @@ import numpy as np
 import scipy.fft
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.system import next_pow2
-from sarcli.io.scan import Scan
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.gbsar import Scan
 
 WINDOWS = ("hamming", "hann", "none")
 

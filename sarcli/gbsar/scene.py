@@ -37,9 +37,10 @@ from typing import Any
 
 import numpy as np
 
-from sarcli.errors import FormatError, SarcliError
-from sarcli.gbsar import C_LIGHT
-from sarcli.io.scan import POLARIZATIONS, Antenna, Site
+from sarcli.errors import ConfigError, FormatError, SarcliError
+from sarcli.io.scan import POLARIZATIONS
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.gbsar import Antenna, Site
 
 EFFECTS = ("antenna_pattern", "noise", "vertical_baseline", "frequency_shift", "displacement",
            "decorrelation", "atmosphere")
@@ -353,9 +354,9 @@ def load_scene(path: str | os.PathLike) -> Scene:
     except FileNotFoundError:
         raise SarcliError(f"{path}: no such scene file") from None
     except UnicodeDecodeError:
-        raise FormatError(f"{path}: scene file is not UTF-8 text") from None
+        raise ConfigError(f"{path}: scene file is not UTF-8 text") from None
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise FormatError(f"{path}: invalid TOML ({e})") from None
+        raise ConfigError(f"{path}: invalid TOML ({e})") from None
     return scene_from_dict(doc, text)

@@ -24,9 +24,10 @@ import numpy as np
 from numba import njit
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.scene import Scene
-from sarcli.io.scan import POLARIZATIONS, Scan
+from sarcli.io.scan import POLARIZATIONS
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.gbsar import Scan
 
 _ANCHOR = 64  # exact phase re-evaluated every _ANCHOR frequencies in the recurrence
 

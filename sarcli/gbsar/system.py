@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
+from sarcli.model.constants import C_LIGHT
 
 
 def next_pow2(n: float) -> int:

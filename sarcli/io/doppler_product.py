@@ -14,7 +14,7 @@ Layout (SI units)::
     /fr_poly          the same for the Doppler rate (Hz/s); an attribute x_power = p (default 0) multiplies
                       it by R^p (map-drift: p = -1, one coefficient -2 Vr^2/lam, fr = -2 Vr^2/(lam R))
 
-``read_doppler(path)`` returns the :class:`sarcli.doppler.model.DopplerModel` (contract 4).
+``read_doppler(path)`` returns the :class:`sarcli.doppler.model.PolyDoppler` (contract 4).
 """
 
 from __future__ import annotations
@@ -24,10 +24,10 @@ import os
 
 import numpy as np
 
-from sarcli.doppler.model import DopplerModel
-from sarcli.doppler.polyfit import Poly2D
 from sarcli.errors import ProductError
 from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, provenance, require, to_jsonable
+from sarcli.model.doppler import PolyDoppler
+from sarcli.model.poly import Poly2D
 
 PRODUCT_TYPE = "doppler"
 SCHEMA_VERSION = "1"
@@ -58,7 +58,7 @@ def _read_poly(f, name: str, path) -> Poly2D:
         raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
 
 
-def write_doppler(path: str | os.PathLike, model: DopplerModel, inputs: tuple = ()) -> None:
+def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = ()) -> None:
     """Write ``model`` atomically to ``path`` (block grid shape from ``model.summary``)."""
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, model.parameters, inputs) as f:
         f.attrs["prf_hz"] = float(model.prf_hz)
@@ -78,8 +78,8 @@ def write_doppler(path: str | os.PathLike, model: DopplerModel, inputs: tuple = 
         _write_poly(f, "fr_poly", model.fr_poly, "Hz/s")
 
 
-def read_doppler(path: str | os.PathLike) -> DopplerModel:
-    """Read a ``doppler.h5`` into a :class:`DopplerModel`; a malformed file raises ProductError (one line)."""
+def read_doppler(path: str | os.PathLike) -> PolyDoppler:
+    """Read a ``doppler.h5`` into a :class:`PolyDoppler`; a malformed file raises ProductError (one line)."""
     with open_product(path, PRODUCT_TYPE) as f:
         sv = attr_str(f, "schema_version")
         if sv != SCHEMA_VERSION:
@@ -97,6 +97,6 @@ def read_doppler(path: str | os.PathLike) -> DopplerModel:
         except json.JSONDecodeError:
             raise ProductError(f"{path}: malformed doppler product, summary_json is not JSON") from None
         params = provenance(f).get("parameters") or {}
-        return DopplerModel(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path),
+        return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path),
                             float(f.attrs["prf_hz"]), float(f.attrs["wavelength_m"]), blocks, summary,
                             params if isinstance(params, dict) else {})

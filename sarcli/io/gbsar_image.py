@@ -17,48 +17,15 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 from sarcli.errors import ProductError
 from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
-from sarcli.io.scan import Site
+from sarcli.model.gbsar import GbsarImage, Site
 
 PRODUCT_TYPE = "gbsar_image"
 SCHEMA_VERSION = "1"
-
-
-@dataclass
-class GbsarImage:
-    image: np.ndarray
-    range_m: np.ndarray
-    azimuth_m: np.ndarray
-    algorithm_map: np.ndarray
-    polarizations: tuple[str, ...]
-    algorithm: str
-    center_frequency_hz: float
-    frequency_step_hz: float
-    n_freq: int
-    rail_height_m: float
-    rail_centre_m: float
-    rail_length_m: float
-    epoch_utc: str
-    scan_time_s: float
-    site: Site = field(default_factory=Site)
-    report: dict[str, Any] = field(default_factory=dict)
-
-    def pol(self, name: str) -> np.ndarray:
-        if name not in self.polarizations:
-            raise ProductError(f"image has polarizations {','.join(self.polarizations)}, not {name}")
-        return self.image[self.polarizations.index(name)]
-
-    @property
-    def wavelength_m(self) -> float:
-        from sarcli.gbsar import C_LIGHT
-
-        return C_LIGHT / self.center_frequency_hz
 
 
 _SCALARS = ("algorithm", "center_frequency_hz", "frequency_step_hz", "n_freq", "rail_height_m", "rail_centre_m",

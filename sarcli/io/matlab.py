@@ -37,9 +37,9 @@ import scipy.io
 from orbit.timeutil import format_utc, parse_utc
 from sarcli.errors import FormatError
 from sarcli.io.ceos.samples import is_four_bit
-from sarcli.io.raw import Radar, RawProduct
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import Radar, RawProduct
 
-C_LIGHT = 299_792_458.0
 DEFAULT_EPOCH_UTC = "2002-06-16T00:00:00.000000Z"
 VANCOUVER_PUBLISHED = {
     "published_effective_velocity_mps": 7062.0,

@@ -32,7 +32,6 @@ S21 ∝ exp(-j*4*pi*f*R/c).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 from typing import Any
 
 import h5py
@@ -49,60 +48,11 @@ from sarcli.io.h5common import (
     require,
     write_mapping,
 )
+from sarcli.model.gbsar import Antenna, Scan, Site
 
 PRODUCT_TYPE = "gbsar_scan"
 SCHEMA_VERSION = "1"
 POLARIZATIONS = ("VV", "VH", "HV", "HH")
-
-
-@dataclass
-class Site:
-    """Rail geodetic position (centre) and heading; heading in degrees clockwise from north."""
-
-    latitude_deg: float = 0.0
-    longitude_deg: float = 0.0
-    height_m: float = 0.0
-    heading_deg: float = 0.0
-    look_side: str = "right"
-
-
-@dataclass
-class Antenna:
-    length_azimuth_m: float = 0.25
-    length_range_m: float = 0.25
-    beamwidth_rad: float = float(np.deg2rad(15.0))
-    gain_dbi: float = 20.0
-
-
-@dataclass
-class Scan:
-    """In-memory GB-SAR scan. ``s21`` is (n_pol, n_stops, n_freq) complex64."""
-
-    s21: np.ndarray
-    frequency: np.ndarray
-    rail_position: np.ndarray
-    rail_height: np.ndarray
-    polarizations: tuple[str, ...]
-    epoch_utc: str
-    stop_time: np.ndarray | None = None
-    stop_flags: np.ndarray | None = None
-    site: Site = field(default_factory=Site)
-    antenna: Antenna = field(default_factory=Antenna)
-    instrument: dict[str, Any] = field(default_factory=dict)
-    truth: dict[str, Any] | None = None
-    source: str = "simulated"
-    status: str = "simulated"
-    n_planned: int | None = None
-
-    @property
-    def n_stops(self) -> int:
-        return int(self.s21.shape[1])
-
-    def pol(self, name: str) -> np.ndarray:
-        """(n_stops, n_freq) S21 of one polarization."""
-        if name not in self.polarizations:
-            raise ProductError(f"scan has polarizations {','.join(self.polarizations)}, not {name}")
-        return self.s21[self.polarizations.index(name)]
 
 
 def _validate(s: Scan, where: str) -> None:

@@ -26,11 +26,11 @@ from typing import Any
 
 import numpy as np
 
-from orbit.constants import C_LIGHT
 from sarcli.design.params import doppler_bandwidth
 from sarcli.errors import SarcliError
 from sarcli.focus.quality import point_target_metrics
-from sarcli.io.raw import RawProduct
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import RawProduct
 from sarcli.optical import limitations as lim
 from sarcli.optical.devices import OpticalSettings, seed_mask_coefficients
 from sarcli.optical.emulator import emulate, platform_speed
@@ -132,8 +132,8 @@ def compare(raw: RawProduct, settings: OpticalSettings = OpticalSettings(),
 
     With ``keep_images`` the report also has ``images`` (label -> crop around the brightest target),
     which is not JSON; ``on_step(label)`` is called after each image (progress)."""
-    from sarcli.focus.doppler_models import GeometricDoppler
     from sarcli.focus.rda import focus_rd
+    from sarcli.model.doppler import GeometricDoppler
 
     v = platform_speed(raw)
     if centre_range_m is None:

@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from orbit.constants import C_LIGHT
+from sarcli.model.constants import C_LIGHT
 
 
 @dataclass(frozen=True)

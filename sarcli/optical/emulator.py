@@ -31,10 +31,10 @@ import numpy as np
 import scipy.fft as sfft
 from scipy.signal import fftconvolve
 
-from orbit.constants import C_LIGHT
 from sarcli.errors import SarcliError
 from sarcli.focus.rangecomp import reference_pulse
-from sarcli.io.raw import RawProduct
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import RawProduct
 from sarcli.optical import limitations as lim
 from sarcli.optical.devices import OpticalDesign, OpticalSettings, design, mask_phase
 

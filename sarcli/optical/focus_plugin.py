@@ -10,8 +10,8 @@ import numpy as np
 from sarcli.errors import SarcliError
 from sarcli.focus.algorithms import register
 from sarcli.focus.rda import RdKnobs
-from sarcli.io.raw import RawProduct
-from sarcli.io.slc import SLC, DopplerUsed
+from sarcli.model.raw import RawProduct
+from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.optical import limitations as lim
 from sarcli.optical.devices import CCD, OpticalSettings
 from sarcli.optical.emulator import emulate

@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-C = 299792458.0
+from sarcli.model.constants import C_LIGHT as C
 
 
 @njit(cache=True, inline="always")

@@ -22,7 +22,7 @@ import numpy as np
 
 from orbit.statevectors import StateVectors
 from sarcli.errors import FormatError
-from sarcli.io.raw import Orbit
+from sarcli.model.raw import Orbit
 from sarcli.sim.scene import LinearPlatform, OrbitPlatform, Scene
 
 MARGIN_S = 60.0

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from orbit.constants import C_LIGHT
 from orbit.propagate import Keplerian
-from sarcli.errors import FormatError
+from sarcli.errors import ConfigError, FormatError
+from sarcli.model.constants import C_LIGHT
 
 PLATFORM_TYPES = ("orbit", "state_vectors", "linear")
 
@@ -330,7 +330,7 @@ def parse_scene(text: str, src: str = "<scene>") -> Scene:
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise FormatError(f"{src}: not valid TOML ({e})") from None
+        raise ConfigError(f"{src}: not valid TOML ({e})") from None
     root = _Table(doc, "", src)
     for key in ("scene", "radar", "antenna", "platform"):
         if key not in doc:

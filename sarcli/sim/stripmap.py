@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from numba import get_num_threads
 
-from sarcli.io.raw import Attitude, Radar, RawProduct
+from sarcli.model.raw import Attitude, Radar, RawProduct
 from sarcli.sim.binned import BLOCK_LINES, add_binned_echo
 from sarcli.sim.context import SimContext
 from sarcli.sim.effects import apply_all, configure_all

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from sarcli.gbsar.acquire.emulator import Emulator, scene_source
+from sarcli.acquire.emulator import Emulator, scene_source
 
 SCENE = """
 [scene]

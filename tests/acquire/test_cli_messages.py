@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import shlex
 
-from sarcli.gbsar.acquire.config import format_frequency
+from sarcli.acquire.config import format_frequency
 
 from .conftest import scan_args
 

@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 
-from sarcli.gbsar.acquire.emulator import Emulator, scene_source
+from sarcli.acquire.emulator import Emulator, scene_source
 from sarcli.io.scan import read_scan
 from tests.acquire.conftest import CONFIG, HEIGHT_M, MACHINE_ZERO_M, SCENE, scan_args
 from tests.conftest import run_cli

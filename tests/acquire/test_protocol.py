@@ -10,15 +10,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sarcli.gbsar.acquire.config import load_config
-from sarcli.gbsar.acquire.controller import connect, run_scan, scan_template
-from sarcli.gbsar.acquire.emulator.faults import FaultPlan
-from sarcli.gbsar.acquire.emulator.vna import binary_block, fmt_number, form4_block
-from sarcli.gbsar.acquire.errors import GarbledData
-from sarcli.gbsar.acquire.grbl import parse_status
-from sarcli.gbsar.acquire.motion import move_time, position_at
-from sarcli.gbsar.acquire.prologix import escape, unescape_split
-from sarcli.gbsar.acquire.vna8753 import parse_binary, parse_binary_header, parse_form4
+from sarcli.acquire.config import load_config
+from sarcli.acquire.controller import connect, run_scan, scan_template
+from sarcli.acquire.emulator.faults import FaultPlan
+from sarcli.acquire.emulator.vna import binary_block, fmt_number, form4_block
+from sarcli.acquire.errors import GarbledData
+from sarcli.acquire.grbl import parse_status
+from sarcli.acquire.motion import move_time, position_at
+from sarcli.acquire.prologix import escape, unescape_split
+from sarcli.acquire.vna8753 import parse_binary, parse_binary_header, parse_form4
 from sarcli.io.scan import ScanWriter
 
 
@@ -228,7 +228,7 @@ def test_vna_error_queue_and_readback(emulator, config_path, change, words):
     even when they bypass the configuration checks."""
     from dataclasses import replace
 
-    from sarcli.gbsar.acquire.errors import InstrumentError
+    from sarcli.acquire.errors import InstrumentError
 
     emu = emulator()
     cfg = load_config(config_path)

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.scene import load_scene
 from sarcli.gbsar.simulate import simulate_stop
 from sarcli.io.scan import read_scan
+from sarcli.model.constants import C_LIGHT
 from tests.acquire.conftest import HEIGHT_M, scan_args
 
 

@@ -11,8 +11,10 @@ import pytest
 
 from sarcli.errors import ProductError
 from sarcli.io.h5common import atomic_h5, dataset, provenance
-from sarcli.io.raw import Attitude, Orbit, Radar, RawProduct, read_raw, write_raw
-from sarcli.io.scan import Scan, ScanWriter, read_scan, write_scan
+from sarcli.io.raw import read_raw, write_raw
+from sarcli.io.scan import ScanWriter, read_scan, write_scan
+from sarcli.model.gbsar import Scan
+from sarcli.model.raw import Attitude, Orbit, Radar, RawProduct
 
 
 def _raw(n_lines=16, n_samples=32, seed=0) -> RawProduct:

@@ -7,7 +7,7 @@ import pytest
 
 from sarcli.doppler.cde import block_correlation, combine
 from sarcli.doppler.dataonly import DataOnlyEstimate, combine_estimates, mlbf, mlcc
-from sarcli.io.raw import Radar
+from sarcli.model.raw import Radar
 from tests.doppler.synth import C, point_target_raw
 
 PRF, FS, F0, K, TP = 1000.0, 60e6, 5.3e9, -12.5e12, 4e-6

@@ -11,7 +11,7 @@ import pytest
 from sarcli.doppler.api import estimate_doppler
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.errors import SarcliError
-from sarcli.io.raw import Attitude
+from sarcli.model.raw import Attitude
 from tests.doppler.conftest import scene_text, simulate_text
 
 BIG = dict(n_lines=2048, density=1.5e-4, azimuth_extent_m=20000.0)

@@ -10,11 +10,11 @@ import pytest
 
 from sarcli.doppler.api import estimate_doppler
 from sarcli.doppler.mapdrift import map_drift
-from sarcli.doppler.polyfit import Poly2D
 from sarcli.doppler.rangecomp import range_compress_valid
 from sarcli.errors import SarcliError
 from sarcli.io.doppler_product import read_doppler, write_doppler
-from sarcli.io.raw import Radar
+from sarcli.model.poly import Poly2D
+from sarcli.model.raw import Radar
 from tests.doppler.conftest import SCENES, simulate_text
 from tests.doppler.synth import C, point_target_raw
 

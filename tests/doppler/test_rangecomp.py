@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from sarcli.doppler.rangecomp import range_compress_extended, range_compress_valid
-from sarcli.io.raw import Radar
+from sarcli.model.raw import Radar
 from tests.doppler.synth import C
 
 FS, F0 = 32e6, 5.3e9

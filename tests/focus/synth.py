@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sarcli.io.raw import Radar, RawProduct
+from sarcli.model.raw import Radar, RawProduct
 
 C = 299792458.0
 

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from sarcli.errors import SarcliError
-from sarcli.focus.doppler_models import GeometricDoppler
 from sarcli.focus.quality import point_target_metrics
 from sarcli.focus.rda import focus_rd
+from sarcli.model.doppler import GeometricDoppler
 
 from .synth import C, scene
 

@@ -8,12 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sarcli.focus.backprojection import backproject, backproject_numpy
-from sarcli.focus.doppler_models import GeometricDoppler
 from sarcli.focus.interp import INTERPOLATORS, interpolate_numpy, sinc_weights, table_for
 from sarcli.focus.kinematics import beam_centre_offset, velocity_and_squint
 from sarcli.focus.rangecomp import apply_range_filter_2d, apply_range_filter_2d_numpy
 from sarcli.focus.rcmc import rcmc_azimuth, rcmc_azimuth_numpy
 from sarcli.focus.windows import window_table
+from sarcli.model.doppler import GeometricDoppler
 
 
 @pytest.mark.parametrize("interp", INTERPOLATORS)

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from sarcli.focus.backprojection import backproject_grid
-from sarcli.focus.doppler_models import GeometricDoppler
 from sarcli.focus.quality import point_target_metrics
 from sarcli.focus.rangecomp import compress_lines, range_filter
 from sarcli.focus.rda import focus_rd
+from sarcli.model.doppler import GeometricDoppler
 
 from .synth import C, beam_offset, scene, sin_squint
 from .theory import irf_theory

@@ -8,11 +8,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.backprojection import bp_kernel, bp_reference, taper_table
 from sarcli.gbsar.focus import FocusOptions, Grid, focus_scan
 from sarcli.gbsar.rangecomp import range_compress
 from sarcli.gbsar.system import azimuth_resolution, df_min_range
+from sarcli.model.constants import C_LIGHT
 from tests.gbsar.helpers import fft_upsample, peak_near, pslr_db, scan_of, width_at
 
 LAM = C_LIGHT / 5.3e9

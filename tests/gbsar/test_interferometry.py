@@ -148,7 +148,7 @@ def test_polarimetric_normalized_difference():
 
 def _synthetic(image, alg_map=None, report=None, **kw):
     """A one-polarization GbsarImage on a 1 m grid (ranges 40.., azimuths centred on the rail)."""
-    from sarcli.io.gbsar_image import GbsarImage
+    from sarcli.model.gbsar import GbsarImage
 
     n_r, n_x = image.shape
     d = dict(image=image[None].astype(np.complex64), range_m=40.0 + np.arange(n_r, dtype=float),

@@ -8,7 +8,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.scene import load_scene, scene_from_dict
 from sarcli.gbsar.simulate import (
     antenna_gain,
@@ -17,6 +16,7 @@ from sarcli.gbsar.simulate import (
     simulate,
     simulate_stop,
 )
+from sarcli.model.constants import C_LIGHT
 from tests.conftest import SAMPLES
 
 

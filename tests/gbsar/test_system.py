@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from sarcli.gbsar import C_LIGHT
 from sarcli.gbsar.system import azimuth_resolution, build_system, df_min_range, df_phase_error, next_pow2
+from sarcli.model.constants import C_LIGHT
 from tests.conftest import SAMPLES
 
 # Table 1 of seed 000 (indoor, outdoor); the paper uses c = 3e8, hence rel tolerances of 0.2-0.5 %

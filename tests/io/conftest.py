@@ -12,7 +12,7 @@ import pytest
 
 from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
 from sarcli.io.ceos import aux as A
-from sarcli.io.raw import Orbit, Radar, RawProduct
+from sarcli.model.raw import Orbit, Radar, RawProduct
 
 C = 299_792_458.0
 PRF_CODE, WINDOW_CODE, ADC, N_PULSES = 4283, 1262, 0, 8

@@ -16,7 +16,8 @@ from orbit.timeutil import parse_utc
 from sarcli.errors import FormatError
 from sarcli.io.ceos import CeosExportError, read_ceos, write_ceos
 from sarcli.io.ceos import aux as A
-from sarcli.io.raw import Orbit
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import Orbit
 
 
 def abs_times(p) -> np.ndarray:
@@ -146,7 +147,7 @@ def test_unrepresentable_products_are_refused(make_raw, tmp_path, change, match)
 def test_window_start_picks_pulses_in_flight_from_dwp(make_raw, tmp_path):
     raw = make_raw(n_lines=8, replica=False)
     tau = float(A.first_sample_time(300, 4283, 0, 9))  # a far-range window: 9 pulses in flight
-    raw.radar.window_start_s, raw.radar.first_range_m = tau, A.C_LIGHT * tau / 2
+    raw.radar.window_start_s, raw.radar.first_range_m = tau, C_LIGHT * tau / 2
     write_ceos(tmp_path / "s", raw)
     x = read_ceos(tmp_path / "s").extra_attrs
     assert (x["ceos_pulses_in_flight"], x["ceos_window_start_code"], x["ceos_beam_name"]) == (9, 300, "FN4")
@@ -172,7 +173,7 @@ def test_roundtrip_property_over_codes(make_raw, tmp_path_factory, adc, prf_code
     r.range_sampling_rate_hz = 1 / float(A.clock_period_s(adc))
     r.prf_hz = 1 / pri
     r.window_start_s = float(A.first_sample_time(w, prf_code, adc, n_p))
-    r.first_range_m = A.C_LIGHT * r.window_start_s / 2
+    r.first_range_m = C_LIGHT * r.window_start_s / 2
     if raw.replica is not None:
         raw.replica = raw.replica[:1].repeat(A.replica_samples(adc))
     pulses = np.arange(n_lines)

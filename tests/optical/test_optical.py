@@ -56,8 +56,8 @@ def test_mask_phase_is_pi_b2_y2_over_x(v, prf, f0, R, rows):
 
 def test_ideal_optical_equals_digital_rd(raw):
     from sarcli.design.params import doppler_bandwidth
-    from sarcli.focus.doppler_models import GeometricDoppler
     from sarcli.focus.rda import focus_rd
+    from sarcli.model.doppler import GeometricDoppler
 
     slc = focus_rd(raw, GeometricDoppler(250.0, 0.0, raw.radar.wavelength_m), azimuth_window="rect",
                    range_window="rect", azimuth_bandwidth_hz=doppler_bandwidth(raw.echo, raw.radar.prf_hz))

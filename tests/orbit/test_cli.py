@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from orbit.frames import eci_to_ecef
-from sarcli.io.raw import Orbit, Radar, RawProduct, write_raw
+from sarcli.io.raw import write_raw
+from sarcli.model.raw import Orbit, Radar, RawProduct
 from tests.orbit.truth import EPOCH, SPACING
 
 

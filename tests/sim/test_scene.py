@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from sarcli.errors import FormatError
+from sarcli.errors import FormatError, SarcliError
 from sarcli.sim.effects import known_effects
 from sarcli.sim.scene import LinearPlatform, OrbitPlatform, load_scene, parse_scene
 from tests.sim.conftest import linear_scene_text, orbit_scene_text
@@ -52,7 +52,7 @@ def test_samples_parse():
     (orbit_scene_text().replace('first_range_m = 993400.0', 'first_range_m = "far"'), "expected a finite number"),
 ])
 def test_bad_scenes_one_line(text, message):
-    with pytest.raises(FormatError) as ei:
+    with pytest.raises(SarcliError) as ei:
         parse_scene(text, "bad.toml")
     msg = str(ei.value)
     assert message in msg and "\n" not in msg and msg.startswith("bad.toml")

@@ -24,9 +24,10 @@ def _doppler_model(raw, shape, doppler_path: Path | None, fdc: float | None, fr:
     if (fdc is None) != (fr is None):
         raise SarcliError("--fdc and --fr go together (centroid Hz and Doppler rate Hz/s)")
     if fdc is not None:
-        from sarcli.focus.doppler_models import GeometricDoppler
+        from sarcli.model.constants import C_LIGHT
+        from sarcli.model.doppler import GeometricDoppler
 
-        r_mid = raw.radar.first_range_m + (shape[1] // 2) * 299792458.0 / (2 * raw.radar.range_sampling_rate_hz)
+        r_mid = raw.radar.first_range_m + (shape[1] // 2) * C_LIGHT / (2 * raw.radar.range_sampling_rate_hz)
         return (GeometricDoppler.from_centroid_and_rate(fdc, fr, r_mid, raw.radar.wavelength_m),
                 f"given: fdc {fdc:.1f} Hz, fr {fr:.2f} Hz/s at {r_mid:.0f} m")
     info("no --doppler given: the Doppler centroid and rate are estimated from the data", quiet)
@@ -93,7 +94,8 @@ def focus(
     from sarcli.focus.rda import focus_stream, make_knobs
     from sarcli.io.h5common import open_product
     from sarcli.io.raw import raw_shape, read_raw
-    from sarcli.io.slc import SLC, slc_writer, write_slc
+    from sarcli.io.slc import slc_writer, write_slc
+    from sarcli.model.slc import SLC
 
     t_start = time.perf_counter()
     _check_output_options(looks_az, looks_rg, crs, spacing, azimuth_bandwidth, range_band_fraction)

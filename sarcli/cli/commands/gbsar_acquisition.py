@@ -14,11 +14,12 @@ import typer
 
 from sarcli.cli.common import emit_json, info, progress_bar
 from sarcli.cli.gbsar_app import attach, gbsar_app
+from sarcli.errors import Interrupted
 
 
 def _overrides(start, stop, points, ifbw, power, data_format, pol, switch, rail_start, step, count, settle,
                lat, lon, site_height, heading) -> dict:
-    from sarcli.gbsar.acquire.config import parse_frequency
+    from sarcli.acquire.config import parse_frequency
 
     return {
         "vna": {"start_hz": None if start is None else parse_frequency(start),
@@ -99,9 +100,9 @@ def scan_cmd(
 
       sarcli gbsar scan --port /dev/pts/3 --rail-port /dev/pts/4 -c samples/scan.toml --pol VV,HH --switch grbl -o s.h5
     """
+    from sarcli.acquire.config import load_config
+    from sarcli.acquire.session import StopGuard, acquire, failure, plan_summary
     from sarcli.errors import SarcliError
-    from sarcli.gbsar.acquire.config import load_config
-    from sarcli.gbsar.acquire.session import StopGuard, acquire, failure, plan_summary
 
     cfg = load_config(config, _overrides(start, stop, points, ifbw, power, data_format, pol, switch, rail_start,
                                          step, count, settle, lat, lon, site_height, heading))
@@ -168,8 +169,8 @@ def emulate_cmd(
     import signal
     import threading
 
+    from sarcli.acquire.emulator import Emulator, scene_source
     from sarcli.errors import SarcliError
-    from sarcli.gbsar.acquire.emulator import Emulator, scene_source
 
     source, zero, h = None, machine_zero or 0.0, height or 0.0
     if scene is not None:
@@ -222,9 +223,9 @@ def repeat_cmd(
       sarcli gbsar repeat --every 30m --count 9 --port /dev/ttyUSB0 --rail-port /dev/ttyACM0 \\
           -c samples/scan.toml -o 'series/scan_{index:02d}_{utc}.h5'
     """
+    from sarcli.acquire.config import load_config, parse_duration
+    from sarcli.acquire.session import StopGuard, acquire, failure
     from sarcli.errors import SarcliError
-    from sarcli.gbsar.acquire.config import load_config, parse_duration
-    from sarcli.gbsar.acquire.session import StopGuard, acquire, failure
 
     period = parse_duration(every)
     if count < 1 or period < 0:
@@ -263,8 +264,7 @@ def repeat_cmd(
     if guard.requested:
         last = summaries[-1] if summaries else {}
         raise failure(last, _series_resume_command(port, rail_port, config, last["output"])) \
-            if "n_complete" in last else SarcliError(
-            "interrupted", exit_code=130)
+            if "n_complete" in last else Interrupted("interrupted")
     if failed:
         raise SarcliError(f"{failed} of {count} scans did not complete (see above)")
     info(f"{count} scans written")

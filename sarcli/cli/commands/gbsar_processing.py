@@ -14,7 +14,7 @@ import typer
 from sarcli.cli.common import emit_json, info, progress, require_output_folders
 from sarcli.cli.gbsar_app import attach, gbsar_app
 from sarcli.errors import SarcliError
-from sarcli.gbsar import C_LIGHT
+from sarcli.model.constants import C_LIGHT
 
 
 @gbsar_app.command("simulate")

@@ -57,7 +57,7 @@ def _time_span(f, name: str, epoch: str | None) -> dict[str, Any]:
 
 
 def _raw_summary(f, summary: dict[str, Any]) -> None:
-    from orbit.constants import C_LIGHT
+    from sarcli.model.constants import C_LIGHT
 
     radar = _attrs(f["radar"]) if "radar" in f else {}
     epoch = summary.get("epoch_utc")

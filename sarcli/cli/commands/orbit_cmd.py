@@ -60,9 +60,9 @@ def _scene_geometry(raw, sv, n_samples: int) -> dict:
     first and last range samples, at the scene-centre line (ECI/ECEF orbits)."""
     import numpy as np
 
-    from orbit.constants import C_LIGHT
     from orbit.geodetic import ecef_to_geodetic
     from orbit.geometry import incidence_angle, look_angle, target_from_doppler
+    from sarcli.model.constants import C_LIGHT
 
     svf = sv.to_ecef()
     t = raw.azimuth_time

@@ -37,7 +37,6 @@ AUX_SYNC = 0x352EF853
 SMO_HZ = 129.2683e6  # satellite master oscillator [A]
 TRANSMIT_DELAY_S = 4.04e-6  # [A], calibrated on corner reflectors
 REPLICA_DURATION_S = 44.559e-6  # [A], [M]
-C_LIGHT = 299_792_458.0
 
 # (bit offset from the start of the block, width) — MSB-first numbering.
 FIELDS: dict[str, tuple[int, int]] = {

@@ -43,7 +43,8 @@ from sarcli.io.ceos import aux as A
 from sarcli.io.ceos.datafile import ECHO_START, index_records
 from sarcli.io.ceos.leader import parse_leader
 from sarcli.io.ceos.samples import decode_lines, decode_reference
-from sarcli.io.raw import Orbit, Radar, RawProduct
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import Orbit, Radar, RawProduct
 
 MISSING_POLICIES = ("zero", "repeat", "keep")
 NOMINAL_PULSE_LENGTH_S = 42e-6
@@ -218,9 +219,9 @@ def read_ceos(leader: str | os.PathLike, data: str | os.PathLike | None = None, 
     else:
         pulse = NOMINAL_PULSE_LENGTH_S
     radar = Radar(
-        carrier_frequency_hz=A.C_LIGHT / wavelength, wavelength_m=wavelength, prf_hz=prf,
+        carrier_frequency_hz=C_LIGHT / wavelength, wavelength_m=wavelength, prf_hz=prf,
         range_sampling_rate_hz=fs, chirp_rate_hz_per_s=chirp, pulse_length_s=pulse,
-        window_start_s=tau0, first_range_m=A.C_LIGHT * tau0 / 2.0,
+        window_start_s=tau0, first_range_m=C_LIGHT * tau0 / 2.0,
         quantization_bits=int(info.bits_per_channel or 4),
     )
     extra = {

@@ -45,7 +45,8 @@ from sarcli.io.ceos import fields as F
 from sarcli.io.ceos.datafile import ECHO_START, build_descriptor, build_prefix
 from sarcli.io.ceos.leader import LeaderInfo, StateVectorRecord, build_leader
 from sarcli.io.ceos.samples import encode, is_four_bit, quantize_replica
-from sarcli.io.raw import RawProduct
+from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import RawProduct
 
 REPLICA_FIRST_LINE, REPLICA_PERIOD = 6, 8  # 0-based: lines 7, 15, 23, ... (1-based)
 PAYLOAD_IMAGING = 0x8000  # (status >> 13) & 7 == 4: "imaging" per [A]
@@ -95,7 +96,7 @@ def _window(tau0: float, prf_code: int, adc: int, beam_hint: int | None) -> tupl
         if 0 <= k < 1 << 12 and abs(code - k) <= 1e-3:
             options.append((not (0 <= dwp < pri), beam != beam_hint, beam, n_p, k))
     if not options:
-        raise _refuse(f"window start {tau0 * 1e6:.4f} us (first range {A.C_LIGHT * tau0 / 2:.2f} m) is not "
+        raise _refuse(f"window start {tau0 * 1e6:.4f} us (first range {C_LIGHT * tau0 / 2:.2f} m) is not "
                       "6 T_b (code+5) + N/PRF - 4.04 us for a 12-bit code and N = 7..11 pulses in flight")
     _, _, beam, n_p, k = min(options)
     return beam, n_p, k

@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from sarcli.errors import SarcliError
-from sarcli.gbsar.acquire.config import ConfigError, ScanConfig, estimate
-from sarcli.gbsar.acquire.controller import check_resume, connect, run_scan, scan_template
-from sarcli.gbsar.acquire.errors import InstrumentError
+from sarcli.acquire.config import ScanConfig, estimate
+from sarcli.acquire.controller import check_resume, connect, run_scan, scan_template
+from sarcli.acquire.errors import InstrumentError, Interrupted
+from sarcli.errors import ConfigError, SarcliError
 from sarcli.io.scan import ScanWriter
 
 
@@ -92,7 +92,7 @@ def acquire(cfg: ScanConfig, vna_port: str, rail_port: str, output: str | os.Pat
                "elapsed_s": res.elapsed_s, "retries": res.retries,
                "overhead_per_stop_ms": float(np.mean(res.overhead_s) * 1e3) if res.overhead_s else None,
                "vna": inst.identity.get("vna_idn"), "rail": inst.identity.get("rail_banner"),
-               "error": res.error or None, "exit_code": res.exit_code}
+               "error": res.error or None, "interrupted": res.interrupted}
     return summary
 
 
@@ -103,5 +103,5 @@ def failure(summary: dict[str, Any], resume_command: str | None = None) -> Sarcl
     """
     n, total, out = summary["n_complete"], summary["n_planned"], summary["output"]
     hint = resume_command or f"sarcli gbsar scan --port VNA_PORT --rail-port RAIL_PORT -c CONFIG --resume {out}"
-    return SarcliError(f"{summary['error']}; {out} keeps {n} of {total} stops; continue with: {hint}",
-                       exit_code=summary["exit_code"] or InstrumentError.exit_code)
+    kind = Interrupted if summary.get("interrupted") else InstrumentError
+    return kind(f"{summary['error']}; {out} keeps {n} of {total} stops; continue with: {hint}")

@@ -18,9 +18,9 @@ from __future__ import annotations
 import time
 from typing import Protocol
 
-from sarcli.gbsar.acquire.errors import InstrumentError
-from sarcli.gbsar.acquire.grbl import GrblRail
-from sarcli.gbsar.acquire.prologix import Prologix
+from sarcli.acquire.errors import InstrumentError
+from sarcli.acquire.grbl import GrblRail
+from sarcli.acquire.prologix import Prologix
 
 SWITCH_KINDS = ("none", "grbl", "11713a")
 

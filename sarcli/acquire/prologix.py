@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import time
 
-from sarcli.gbsar.acquire.errors import InstrumentError, InstrumentTimeout
-from sarcli.gbsar.acquire.port import Port
+from sarcli.acquire.errors import InstrumentError, InstrumentTimeout
+from sarcli.acquire.port import Port
 
 ESC = 0x1B
 _SPECIAL = frozenset(b"\r\n\x1b+")

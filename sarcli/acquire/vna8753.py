@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sarcli.gbsar.acquire.errors import GarbledData, InstrumentError, InstrumentTimeout
-from sarcli.gbsar.acquire.prologix import Prologix
+from sarcli.acquire.errors import GarbledData, InstrumentError, InstrumentTimeout
+from sarcli.acquire.prologix import Prologix
 
 ALLOWED_POINTS = (3, 11, 26, 51, 101, 201, 401, 801, 1601)
 ALLOWED_IFBW_HZ = (10, 30, 100, 300, 1000, 3000, 3700, 6000)

@@ -17,15 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from sarcli.errors import FormatError, SarcliError
-from sarcli.gbsar.acquire import vna8753 as vna
-from sarcli.gbsar.acquire.motion import move_time
-from sarcli.gbsar.acquire.polswitch import SWITCH_KINDS
-from sarcli.io.scan import POLARIZATIONS, Antenna, Site
-
-
-class ConfigError(SarcliError):
-    """The acquisition configuration is invalid."""
+from sarcli.acquire import vna8753 as vna
+from sarcli.acquire.motion import move_time
+from sarcli.acquire.polswitch import SWITCH_KINDS
+from sarcli.errors import ConfigError
+from sarcli.io.scan import POLARIZATIONS
+from sarcli.model.gbsar import Antenna, Site
 
 
 @dataclass(frozen=True)
@@ -139,7 +136,7 @@ def load_config(path: str | Path | None, overrides: dict[str, dict[str, Any]] | 
         try:
             data = tomllib.loads(p.read_text())
         except tomllib.TOMLDecodeError as e:
-            raise FormatError(f"{p}: not valid TOML ({e})") from None
+            raise ConfigError(f"{p}: not valid TOML ({e})") from None
     for section, values in (overrides or {}).items():
         data.setdefault(section, {}).update({k: v for k, v in values.items() if v is not None})
     unknown = set(data) - set(_SECTIONS)

@@ -1,14 +1,14 @@
-"""Instrument errors. All are :class:`sarcli.errors.SarcliError` so the CLI prints one line."""
+"""Instrument errors: kinds of :class:`sarcli.errors.InstrumentError` (the CLI prints one line, exit 3).
+
+``Interrupted`` (Ctrl-C, exit 130) is :class:`sarcli.errors.Interrupted`, re-exported here.
+"""
 
 from __future__ import annotations
 
-from sarcli.errors import SarcliError
+from sarcli.errors import InstrumentError, Interrupted
 
-
-class InstrumentError(SarcliError):
-    """An instrument misbehaved (no answer after the retries, refused a command, wrong identity)."""
-
-    exit_code = 3
+__all__ = ["ALARM_TEXT", "GRBL_ERROR_TEXT", "Disconnected", "GarbledData", "InstrumentError", "InstrumentTimeout",
+           "Interrupted", "RailAlarm"]
 
 
 class InstrumentTimeout(InstrumentError):
@@ -29,12 +29,6 @@ class RailAlarm(InstrumentError):
     def __init__(self, code: int, message: str = ""):
         self.code = code
         super().__init__(message or f"GRBL ALARM:{code} ({ALARM_TEXT.get(code, 'unknown alarm')})")
-
-
-class Interrupted(InstrumentError):
-    """The user asked to stop (Ctrl-C)."""
-
-    exit_code = 130
 
 
 ALARM_TEXT = {

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import re
 
-from sarcli.gbsar.acquire.emulator.faults import FaultPlan
-from sarcli.gbsar.acquire.emulator.ptylink import PtyDevice
-from sarcli.gbsar.acquire.motion import move_time, position_at
+from sarcli.acquire.emulator.faults import FaultPlan
+from sarcli.acquire.emulator.ptylink import PtyDevice
+from sarcli.acquire.motion import move_time, position_at
 
 BANNER = b"\r\nGrbl 1.1h ['$' for help]\r\n"
 DEFAULT_SETTINGS = {0: 10, 1: 25, 2: 0, 3: 0, 4: 0, 5: 0, 6: 0, 10: 1, 11: 0.010, 12: 0.002, 13: 0,

@@ -16,16 +16,17 @@ from typing import Any
 
 import numpy as np
 
-from sarcli.errors import SarcliError
-from sarcli.gbsar.acquire.config import ConfigError, ScanConfig, to_attrs, validate
-from sarcli.gbsar.acquire.errors import InstrumentError, Interrupted
-from sarcli.gbsar.acquire.grbl import GrblRail
-from sarcli.gbsar.acquire.polswitch import GrblPinSwitch, PolSwitch, SinglePolarization, Switch11713A
-from sarcli.gbsar.acquire.port import Port
-from sarcli.gbsar.acquire.prologix import Prologix
-from sarcli.gbsar.acquire.vna8753 import MAX_FREQUENCY_HZ, MAX_FREQUENCY_OPT006_HZ, Prologix8753
+from sarcli.acquire.config import ScanConfig, to_attrs, validate
+from sarcli.acquire.errors import InstrumentError, Interrupted
+from sarcli.acquire.grbl import GrblRail
+from sarcli.acquire.polswitch import GrblPinSwitch, PolSwitch, SinglePolarization, Switch11713A
+from sarcli.acquire.port import Port
+from sarcli.acquire.prologix import Prologix
+from sarcli.acquire.vna8753 import MAX_FREQUENCY_HZ, MAX_FREQUENCY_OPT006_HZ, Prologix8753
+from sarcli.errors import ConfigError, SarcliError
 from sarcli.io.h5common import open_product
-from sarcli.io.scan import PRODUCT_TYPE, Scan, ScanWriter
+from sarcli.io.scan import PRODUCT_TYPE, ScanWriter
+from sarcli.model.gbsar import Scan
 
 
 @dataclass
@@ -136,7 +137,7 @@ class ScanResult:
     overhead_s: list[float] = field(default_factory=list)  # per stop: time not spent in sweep/move
     retries: int = 0
     error: str = ""
-    exit_code: int = 0
+    interrupted: bool = False
 
 
 def run_scan(cfg: ScanConfig, inst: Instruments, writer: ScanWriter, epoch_utc: str,
@@ -174,8 +175,8 @@ def run_scan(cfg: ScanConfig, inst: Instruments, writer: ScanWriter, epoch_utc: 
         res.status = "complete"
         if r.return_to_start:
             inst.rail.move_to(r.machine_mm(positions[0]), r.feed_mm_min)
-    except InstrumentError as e:
-        res.error, res.exit_code = str(e), e.exit_code
+    except (InstrumentError, Interrupted) as e:
+        res.error, res.interrupted = str(e), isinstance(e, Interrupted)
         if inst.rail.in_motion:
             _safe_hold(inst)
     finally:

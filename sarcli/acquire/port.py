@@ -3,7 +3,7 @@
 pyserial's own ``timeout`` is kept short and fixed (``poll_s``); every read here takes an absolute
 deadline (``time.monotonic()`` seconds) instead, so a caller can wait long (a sweep) while still
 checking a stop flag (Ctrl-C) every ``poll_s``. Any OS-level failure of the port (USB unplugged,
-pseudo-terminal closed) becomes :class:`~sarcli.gbsar.acquire.errors.Disconnected`.
+pseudo-terminal closed) becomes :class:`~sarcli.acquire.errors.Disconnected`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import serial
 
-from sarcli.gbsar.acquire.errors import Disconnected, InstrumentError, InstrumentTimeout, Interrupted
+from sarcli.acquire.errors import Disconnected, InstrumentError, InstrumentTimeout, Interrupted
 
 
 class Port:

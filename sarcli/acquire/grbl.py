@@ -14,15 +14,15 @@ import re
 import time
 from dataclasses import dataclass, field
 
-from sarcli.gbsar.acquire.errors import (
+from sarcli.acquire.errors import (
     GRBL_ERROR_TEXT,
     GarbledData,
     InstrumentError,
     InstrumentTimeout,
     RailAlarm,
 )
-from sarcli.gbsar.acquire.motion import move_time
-from sarcli.gbsar.acquire.port import Port
+from sarcli.acquire.motion import move_time
+from sarcli.acquire.port import Port
 
 POSITION_TOLERANCE_MM = 0.0015  # MPos is reported with 3 decimals
 _STATUS = re.compile(r"^<([A-Za-z]+(?::\d)?)\|(.*)>$")

@@ -18,10 +18,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from sarcli.gbsar.acquire.emulator.faults import FaultPlan
-from sarcli.gbsar.acquire.emulator.ptylink import PtyDevice
-from sarcli.gbsar.acquire.prologix import unescape_split
-from sarcli.gbsar.acquire.vna8753 import (
+from sarcli.acquire.emulator.faults import FaultPlan
+from sarcli.acquire.emulator.ptylink import PtyDevice
+from sarcli.acquire.prologix import unescape_split
+from sarcli.acquire.vna8753 import (
     ALLOWED_IFBW_HZ,
     ALLOWED_POINTS,
     BINARY_FORMATS,

@@ -15,12 +15,12 @@ from collections.abc import Callable
 
 import numpy as np
 
+from sarcli.acquire.emulator.faults import FaultPlan
+from sarcli.acquire.emulator.grbl import EmulatedGrbl
+from sarcli.acquire.emulator.ptylink import Service
+from sarcli.acquire.emulator.vna import EmulatedVna, Source
+from sarcli.acquire.polswitch import SWITCH_KINDS
 from sarcli.errors import SarcliError
-from sarcli.gbsar.acquire.emulator.faults import FaultPlan
-from sarcli.gbsar.acquire.emulator.grbl import EmulatedGrbl
-from sarcli.gbsar.acquire.emulator.ptylink import Service
-from sarcli.gbsar.acquire.emulator.vna import EmulatedVna, Source
-from sarcli.gbsar.acquire.polswitch import SWITCH_KINDS
 
 
 def thru_source(position_m: float, frequency_hz: np.ndarray, pol: str) -> np.ndarray:

@@ -1,0 +1,71 @@
+"""The focused single-look complex image model (zero-Doppler lines, slant-range columns).
+
+Phase convention: a scatterer at closest range R0 has phase ``arg(sigma) - 4 pi R0 / lam`` at its
+peak. The file layout is in ``sarcli.io.slc``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sarcli.model.raw import Attitude, Orbit, Radar
+
+
+@dataclass
+class DopplerUsed:
+    """Centroid, rate and effective velocity used per processing block (rows) and range (columns)."""
+
+    block_time: np.ndarray
+    range_m: np.ndarray
+    fdc_hz: np.ndarray
+    fr_hz_per_s: np.ndarray
+    velocity_mps: np.ndarray
+
+
+@dataclass
+class SLC:
+    """In-memory focused image with its axes; ``image`` (n_lines, n_samples) complex64."""
+
+    image: np.ndarray
+    azimuth_time: np.ndarray
+    slant_range: np.ndarray
+    epoch_utc: str
+    radar: Radar
+    doppler: DopplerUsed
+    look_side: str = "right"
+    source: str = "simulated"
+    algorithm: str = "rd"
+    azimuth_spacing_m: float = float("nan")
+    first_full_line: int = 0
+    last_full_line: int = -1
+    parameters: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+    orbit: Orbit | None = None
+    attitude: Attitude | None = None
+    truth: dict[str, Any] | None = None
+
+    @classmethod
+    def placeholder(cls, raw, shape: tuple[int, int]) -> SLC:
+        """An empty SLC for :func:`slc_writer` to fill while streaming (see :meth:`update_from`)."""
+        e = np.zeros(0)
+        return cls(image=np.zeros((0, 0), np.complex64), azimuth_time=np.zeros(shape[0]),
+                   slant_range=np.zeros(shape[1]), epoch_utc=raw.epoch_utc, radar=raw.radar,
+                   doppler=DopplerUsed(e, e, e, e, e))
+
+    def update_from(self, other: SLC) -> None:
+        """Take every field of ``other`` except the image (metadata known after streaming)."""
+        for f in dataclasses.fields(self):
+            if f.name != "image":
+                setattr(self, f.name, getattr(other, f.name))
+
+    @property
+    def prf_hz(self) -> float:
+        return float(1.0 / np.median(np.diff(self.azimuth_time))) if self.azimuth_time.size > 1 else self.radar.prf_hz
+
+    @property
+    def range_spacing_m(self) -> float:
+        return float(self.slant_range[1] - self.slant_range[0]) if self.slant_range.size > 1 else float("nan")
