@@ -43,8 +43,11 @@ class SarcliGroup(TyperGroup):
     """A command group that turns user errors into one line on stderr and a non-zero exit."""
 
     def invoke(self, ctx: typer.Context) -> Any:
+        from sarcli.io.provenance import Provenance, using
+
         try:
-            return super().invoke(ctx)
+            with using(Provenance(command_line=command_line())):
+                return super().invoke(ctx)
         except (SarcliError, OrbitError) as e:  # OrbitError: impossible geometry, bad state vectors
             raise fail(str(e), exit_code_for(e)) from None
         except (FileNotFoundError, PermissionError, IsADirectoryError) as e:
@@ -52,6 +55,16 @@ class SarcliGroup(TyperGroup):
             raise fail(f"{name}: {e.strerror}" if name else str(e), exit_code_for(e)) from None
         except KeyboardInterrupt as e:
             raise fail("interrupted", exit_code_for(e)) from None
+
+
+def command_line() -> str:
+    """The command as the user typed it (program name without its folder), for the products' provenance."""
+    from pathlib import Path
+
+    argv = list(sys.argv)
+    if argv:
+        argv[0] = Path(argv[0]).name
+    return " ".join(argv)
 
 
 def make_typer(**kwargs: Any) -> typer.Typer:

@@ -18,7 +18,6 @@ import datetime as _dt
 import hashlib
 import json
 import os
-import sys
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ import numpy as np
 from sarcli import __version__
 from sarcli.errors import ProductError
 from sarcli.io.atomic import atomic_path
+from sarcli.io.provenance import current
 
 PROVENANCE_ATTRS = (
     "product_type",
@@ -115,17 +115,10 @@ def atomic_h5(
             f.attrs["schema_version"] = schema_version
             f.attrs["software_version"] = __version__
             f.attrs["created_utc"] = created_utc()
-            f.attrs["command_line"] = command_line if command_line is not None else _command_line()
+            f.attrs["command_line"] = command_line if command_line is not None else current().command_line
             f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
-
-
-def _command_line() -> str:
-    argv = list(sys.argv)
-    if argv:
-        argv[0] = Path(argv[0]).name
-    return " ".join(argv)
 
 
 def dataset(
