@@ -15,4 +15,18 @@ are registered in :data:`WORKFLOWS` by step name.
 
 from sarcli.registry import Registry
 
-WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {})
+WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
+    "ingest": "sarcli.workflows.ingest",
+    "info": "sarcli.workflows.info",
+    "simulate": "sarcli.workflows.simulate",
+    "orbit_info": "sarcli.workflows.orbit_info",
+    "orbit_interpolate": "sarcli.workflows.orbit_interpolate",
+    "orbit_accuracy": "sarcli.workflows.orbit_accuracy",
+    "ati_detect": "sarcli.workflows.ati_detect",
+    "ati_estimate": "sarcli.workflows.ati_estimate",
+    "ati_compensate": "sarcli.workflows.ati_compensate",
+    "ati_montecarlo": "sarcli.workflows.ati_montecarlo",
+    "optical_compare": "sarcli.workflows.optical_compare",
+    "design": "sarcli.workflows.design",
+    "run": "sarcli.workflows.run",
+})
