@@ -188,12 +188,13 @@ def progress_sink(disable: bool = False) -> Iterator[Any]:
 # Running a workflow from a command's options
 
 
-_FIELD = re.compile(r"^([a-z][a-z0-9_]*)(?=[ :\[])")
+_FIELD = re.compile(r"^([a-z][a-z0-9_]*)(?=:| must | ')")
 
 
 def name_options(message: str, flags: Mapping[str, str]) -> str:
     """A configuration message that starts with a field name (``max_gap must be ...``, ``route: 'x' is
-    not one of ...``) reworded to name the command-line option as typed (``--max-gap must be ...``)."""
+    not one of ...``, ``route 'x': choose ...``) reworded to name the command-line option as typed
+    (``--max-gap must be ...``); other messages (``output folder ... does not exist``) are kept."""
     m = _FIELD.match(message)
     if m and m.group(1) in flags:
         return flags[m.group(1)] + message[m.end():]

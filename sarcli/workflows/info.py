@@ -334,14 +334,17 @@ def _formats() -> str:
 
 def describe_geotiff(path: Path) -> dict[str, Any]:
     """Size, bands, CRS, bounds, resolution, nodata, GCPs, overviews and tags of a GeoTIFF (rasterio)."""
+    import warnings
+
     import rasterio
-    from rasterio.errors import RasterioIOError
+    from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 
     try:
         ds = rasterio.open(path)
     except RasterioIOError as e:
         raise ProductError(f"{path}: not a readable GeoTIFF ({' '.join(str(e).split())})") from None
-    with ds:
+    with ds, warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)  # reported: crs and transform are null
         crs = ds.crs
         gcps, gcp_crs = ds.gcps
         bands = []

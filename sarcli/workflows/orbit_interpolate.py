@@ -63,7 +63,7 @@ def parse_times(spec: str | tuple[float | str, ...], epoch_utc: str) -> list[flo
                     raise ValueError
                 n = int(np.floor((b - a) / c + 1e-9)) + 1
                 if n > MAX_TIMES:
-                    raise ConfigError(f"times range {item!r} has {n} points (max 10 000 000)")
+                    raise ConfigError(f"times: range {item!r} has {n} points (max 10 000 000)")
                 out.extend((a + c * np.arange(n)).tolist())
             else:
                 out.append(float(item))
@@ -71,7 +71,7 @@ def parse_times(spec: str | tuple[float | str, ...], epoch_utc: str) -> list[flo
             raise ConfigError(f"times: cannot read {item!r}; use numbers (s after the epoch), "
                               "start:stop:step with step > 0, or ISO-8601 UTC times") from None
     if not out:
-        raise ConfigError("times is empty")
+        raise ConfigError("times: no time given")
     return out
 
 
