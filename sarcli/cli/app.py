@@ -44,7 +44,7 @@ def _root(
                                 help="Show diagnostics on stderr: -v progress of each step, -vv debugging detail."),
     quiet: bool = typer.Option(False, "--quiet", "-q",
                                help="Hide status lines and progress bars (results, warnings and errors stay)."),
-    log_file: Path = typer.Option(None, "--log-file", dir_okay=False,
+    log_file: Path = typer.Option(None, "--log-file", dir_okay=False, metavar="PATH",
                                   help="Append every diagnostic (DEBUG), status line, warning and error, "
                                        "with times, to this file."),
 ) -> None:

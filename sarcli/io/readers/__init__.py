@@ -8,12 +8,14 @@ A reader is an object (usually a module-level instance) with
   given on the command line is this reader's format; it may raise a one-line
   :class:`~sarcli.errors.SarcliError` when the input is recognisably its format but incomplete
   (shown when no other reader accepts the input);
-- ``read(sources, options) -> Ingested``: decode it, validated (``RawProduct.validate``), with the
-  paths it actually read (their hashes go into the product's provenance) and status notes.
+- ``read(sources, options) -> Ingested``: decode it into one or more raw products (validated again when
+  written, ``sarcli.io.raw.write_raw``), with the paths it actually read (their hashes go into the
+  product's provenance) and status notes.
 
 ``sarcli ingest`` and ``sarcli info`` find the reader by sniffing (:func:`find_reader`), or by name
 (``--format NAME``). Built-in readers are registered in :data:`READERS`; another package adds one with
-an entry point in the group ``sarcli.readers``, a test with ``READERS.register(name, reader)``.
+an entry point in the group ``sarcli.readers``, a test with ``READERS.register(name, reader)``. The
+recipe, exercised by ``tests/io/test_toy_reader.py``: ``docs/ingest.md``, "A new sensor reader".
 """
 
 from __future__ import annotations
