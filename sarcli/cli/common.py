@@ -205,7 +205,7 @@ def run_workflow(step: str, options: Mapping[str, Any], flags: Mapping[str, str]
                  progress_disabled: bool = False) -> Any:
     """Build workflow ``step``'s ``Config`` from a command's options (``None``: not given, the default
     applies), run it with a progress bar, return its report. Configuration messages name the options as
-    typed: a field ``max_gap`` is ``--max-gap`` unless ``flags`` says otherwise (``{"bin_mode": "--bin"}``).
+    typed: a field ``max_gap`` is ``--max-gap`` unless ``flags`` says otherwise (``{"raw": "RAW"}``).
     The provenance is the command line (set for the whole invocation by :class:`SarcliGroup`)."""
     import dataclasses
 
@@ -242,14 +242,21 @@ def parse_option_values(items: Iterable[str], flag: str = "--option") -> dict[st
     return out
 
 
-def print_report(report: Any, as_json: bool, stream: str = "stdout") -> None:
-    """A workflow report: ``--json`` -> its ``to_dict()`` on stdout, else its ``lines()`` on ``stream``
-    (``"stderr"``: status lines, hidden by ``--quiet``)."""
+def print_report(report: Any, as_json: bool) -> None:
+    """A workflow report as the command's result: ``--json`` -> its ``to_dict()``, else its ``lines()``,
+    on stdout."""
     if as_json:
         emit_json(report.to_dict())
         return
     for line in report.lines():
-        (typer.echo if stream == "stdout" else info)(line)
+        typer.echo(line)
+
+
+def print_status(report: Any) -> None:
+    """A workflow report's ``lines()`` as status lines on stderr (hidden by ``--quiet``): for commands
+    whose result is a file, or whose ``--json`` goes to stdout alongside."""
+    for line in report.lines():
+        info(line)
 
 
 # ---------------------------------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, make_typer, run_workflow
+from sarcli.cli.common import emit_json, make_typer, print_status, run_workflow
 
 ati_app = make_typer(help="SAR along-track interferometry: detect, estimate, compensate ground movers.")
 
@@ -16,11 +16,6 @@ _UNWRAP = typer.Option("dechirp", "--unwrap", help="Phase unwrapping: dechirp (m
 _BIN = typer.Option("track", "--bin", help="Range bin: track (per-line peak near the ANV bin) or anv (seed: one bin).")
 _PFA = typer.Option(1e-6, "--pfa", help="False-alarm probability per pixel of each CFAR test (magnitude, phase).")
 _FLAGS = {"raw": "RAW", "png_dir": "--png-dir"}
-
-
-def _status(report) -> None:
-    for line in report.lines():
-        info(line)
 
 
 @ati_app.command("detect")
@@ -45,7 +40,7 @@ def detect_cmd(
       sarcli ati detect raw2ch.h5 --pfa 1e-5 --json -o detect.h5
     """
     report = run_workflow("ati_detect", {"raw": raw_path, "output": output, "pfa": pfa}, flags=_FLAGS)
-    _status(report)
+    print_status(report)
     if as_json:
         emit_json(report.to_dict())
 
@@ -76,7 +71,7 @@ def estimate_cmd(
     """
     report = run_workflow("ati_estimate", {"raw": raw_path, "output": output, "route": route, "unwrap": unwrap,
                                            "bin": bin_mode, "pfa": pfa}, flags=_FLAGS)
-    _status(report)
+    print_status(report)
     if as_json:
         emit_json(report.to_dict()["movers"])
 
@@ -112,7 +107,7 @@ def compensate_cmd(
     report = run_workflow("ati_compensate", {"raw": raw_path, "output": output, "method": method,
                                              "compare": compare_conventional, "png_dir": png_dir, "route": route,
                                              "unwrap": unwrap, "bin": bin_mode, "pfa": pfa}, flags=_FLAGS)
-    _status(report)
+    print_status(report)
     if as_json:
         emit_json(report.to_dict())
 
@@ -141,7 +136,7 @@ def montecarlo_cmd(
     """
     report = run_workflow("ati_montecarlo", {"scene": scene, "runs": runs, "snr": snr, "seed": seed, "route": route,
                                              "unwrap": unwrap, "bin": bin_mode, "plot": plot}, flags=_FLAGS)
-    _status(report)
+    print_status(report)
     if as_json:
         emit_json(report.to_dict())
 

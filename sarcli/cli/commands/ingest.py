@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, parse_option_values, run_workflow
+from sarcli.cli.common import emit_json, info, parse_option_values, print_status, run_workflow
 from sarcli.errors import ConfigError
 
 
@@ -82,8 +82,7 @@ def ingest(
     if as_json:
         emit_json(report.to_dict())
     else:
-        for line in report.lines():
-            info(line)
+        print_status(report)
 
 
 def register(app: typer.Typer) -> None:

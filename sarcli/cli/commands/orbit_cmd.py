@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, make_typer, print_report, run_workflow
+from sarcli.cli.common import emit_json, info, make_typer, print_report, print_status, run_workflow
 
 orbit_app = make_typer(help="Orbit state vectors: summary, Hermite interpolation, accuracy/cost tables.")
 
@@ -66,8 +66,7 @@ def interpolate_cmd(
     if as_json:
         emit_json(report.to_dict())
     elif csv is not None:
-        for line in report.lines():
-            info(line)
+        print_status(report)
     else:
         print_report(report, False)
 

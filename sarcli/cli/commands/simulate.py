@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, run_workflow
+from sarcli.cli.common import emit_json, print_status, run_workflow
 
 
 def simulate(
@@ -36,8 +36,7 @@ def simulate(
     """
     report = run_workflow("simulate", {"scene": scene, "output": output, "format": fmt, "compression": compression,
                                        "seed": seed})
-    for line in report.lines():
-        info(line)
+    print_status(report)
     if as_json:
         emit_json(report.to_dict())
 
