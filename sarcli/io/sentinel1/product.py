@@ -169,7 +169,7 @@ def _product(data, h, rows, noise, cal, orbit_rec, name, where) -> RawProduct:
              "s1_baq_mode": baq, "s1_range_decimation": int(r0["range_decimation"]),
              "s1_swath_number": int(r0["swath_number"]), "s1_rank": rank, "s1_swst_s": swst,
              "s1_tx_start_frequency_hz": f0, "s1_gps_minus_utc_s": anc.gps_minus_utc(epoch_gps),
-             "s1_polarisation": _polarisation(hs[:1])[0], "s1_n_noise_lines": int(noise.size),
+             "s1_polarisation": str(_polarisation(hs[:1])[0]), "s1_n_noise_lines": int(noise.size),
              "s1_n_calibration_lines": int(cal.size),
              "s1_carrier_note": "carrier not in the packets: Sentinel-1 nominal 5.405 GHz"}
     for label, sel in (("noise", noise), ("calibration", cal)):
