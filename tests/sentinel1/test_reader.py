@@ -200,3 +200,19 @@ def test_wrong_length_in_header_is_refused(tmp_path):
     (tmp_path / "w.dat").write_bytes(E.pack_packets(h, [ud]))
     with pytest.raises(FormatError, match="does not match"):
         read_level0(tmp_path / "w.dat")
+
+
+def test_safe_folder_reads_every_measurement_file(tmp_path, cli):
+    """A .SAFE folder: the VV and VH measurement files become S3_VV and S3_VH; index/annotation skipped."""
+    safe = tmp_path / "S1B_S3_RAW__0SDV_TEST.SAFE"
+    safe.mkdir()
+    for name, rx in (("s1b-s3-raw-s-vv-test.dat", 0), ("s1b-s3-raw-s-vh-test.dat", 1)):
+        (safe / name).write_bytes(_stream([(4, {"rx_channel_id": rx})])[0])
+    (safe / "s1b-s3-raw-s-vv-test-index.dat").write_bytes(b"\0" * 36)
+    (safe / "s1b-s3-raw-s-vv-test-annot.dat").write_bytes(b"\0" * 26)
+    out = tmp_path / "out"
+    out.mkdir()
+    r = cli("ingest", safe, "-o", out)
+    assert r.exit_code == 0, r.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["S3_VH.h5", "S3_VV.h5"]
+    assert read_raw(out / "S3_VH.h5").extra_attrs["s1_polarisation"] == "VH"
