@@ -60,6 +60,7 @@ def test_groups_swst_changes_noise_calibration_and_error_flag(tmp_path):
     path.write_bytes(blob)
     l0 = read_level0(path)
     assert list(l0.products) == ["S3_VV_1", "S3_VV_2"]
+    assert {p.extra_attrs["s1_swath"] for p in l0.products.values()} == {"S3"}
     a, b = l0.products["S3_VV_1"], l0.products["S3_VV_2"]
     np.testing.assert_array_equal(a.echo, np.stack(lines[5:10]))
     np.testing.assert_array_equal(b.echo, np.stack(lines[11:15]))

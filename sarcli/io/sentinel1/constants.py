@@ -7,8 +7,6 @@ here is transcribed from it; where the document contradicts itself the choice is
 
 from __future__ import annotations
 
-import numpy as np
-
 #: Reference frequency of the instrument clock [S1-ISP, §3.2.5.4]: 37.53472224 MHz.
 F_REF_HZ = 37.53472224e6
 #: Packet primary header (6 octets) and secondary header (62 octets) lengths [S1-ISP, §3.1, §3.2].
@@ -165,13 +163,3 @@ SIGMA_FACTORS = (
     248.47, 249.73, 250.98, 252.23, 253.49, 254.74, 255.99, 255.99,
 )
 
-
-def reconstruction_value(nrl: float, sf: float) -> np.float32:
-    """The sample value of normal reconstruction, NRL * SF [S1-ISP, §4.3], as stored (float32).
-
-    Evaluated in float64 and rounded once to float32: with the table values being decimal numbers
-    of at most 6 significant digits, this is the float32 nearest to the exact product (the float64
-    product of the two float64 table values is within 1 ulp(float64) of it, far below the float32
-    rounding step, except for ties, which do not occur for these tables -- see the tests).
-    """
-    return np.float32(nrl * sf)

@@ -144,7 +144,7 @@ def _bursts(time: np.ndarray, pri: float) -> tuple[np.ndarray, np.ndarray]:
     return first, np.diff(np.r_[first, time.size])
 
 
-def _product(data, h, rows, noise, cal, orbit_rec, name, where) -> RawProduct:
+def _product(data, h, rows, noise, cal, orbit_rec, swath, where) -> RawProduct:
     hs = h[rows]
     r0 = hs[0]
     p = physical(hs[:1])
@@ -164,7 +164,7 @@ def _product(data, h, rows, noise, cal, orbit_rec, name, where) -> RawProduct:
                   quantization_bits=10 if baq == 0 else (baq if baq < 12 else 0))
     mode = ECC_MODES.get(int(r0["ecc_number"]), "")
     aux: dict[str, np.ndarray] = {"s1/echo_headers": hs, "s1/echo_time_gps": t_rx}
-    extra = {"s1_swath": name.rsplit("_", 1)[0] if name.count("_") else name, "s1_mode": mode,
+    extra = {"s1_swath": swath, "s1_mode": mode,
              "s1_ecc_number": int(r0["ecc_number"]), "s1_data_take_id": int(r0["data_take_id"]),
              "s1_baq_mode": baq, "s1_range_decimation": int(r0["range_decimation"]),
              "s1_swath_number": int(r0["swath_number"]), "s1_rank": rank, "s1_swst_s": swst,
@@ -224,7 +224,7 @@ def read_level0(path: str | os.PathLike, allow_truncated: bool = False) -> Level
         segs = _segments(h[rows])
         for n, seg in enumerate(segs, start=1):
             name = f"{key[0]}_{key[1]}" + (f"_{n}" if len(segs) > 1 else "")
-            products[name] = _product(data, h, rows[seg], noise, cal, orbit_rec, name, where)
+            products[name] = _product(data, h, rows[seg], noise, cal, orbit_rec, str(key[0]), where)
         if len(segs) > 1:
             notes.append(f"{key[0]}_{key[1]}: the sampling window or pulse changes {len(segs) - 1} time(s): "
                          f"{len(segs)} products")
