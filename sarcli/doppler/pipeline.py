@@ -240,8 +240,27 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
     else:
         res = amb.resolve(fbb, fu, fbb_scene, w, prf, tol)
         source, conf, resolved = "none", 0.0, False
-    return AmbiguityStage(res, source, float(conf), bool(resolved), fdc_orbit, fbb + res.block_ambiguity * prf,
-                          tuple(data_only))
+    fdc_abs = fbb + res.block_ambiguity * prf
+    f_max = max_doppler_hz(raw, options, geo)
+    worst = float(np.max(np.abs(fdc_abs)))
+    if not worst <= f_max:
+        err = ConfigError if source == "user" else ProductError
+        raise err(f"absolute Doppler centroid {worst:.6g} Hz (ambiguity {res.n0}) is beyond the largest Doppler the "
+                  f"platform can produce (2V/lam = {f_max:.6g} Hz): the PRF ({prf:.6g} Hz), the wavelength or the "
+                  "ambiguity is wrong")
+    return AmbiguityStage(res, source, float(conf), bool(resolved), fdc_orbit, fdc_abs, tuple(data_only))
+
+
+def max_doppler_hz(raw: RawProduct, options: DopplerOptions, geo: SceneGeometry | None) -> float:
+    """2 V / lam, the largest Doppler any target can have for a platform at ground speed V: the orbit's
+    ECEF speed at the scene centre; without an orbit the larger of the product's platform velocity and
+    the velocity guess (an upper bound is all this needs)."""
+    if geo is not None:
+        t_c = 0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1])
+        v = float(np.linalg.norm(geo.orbit.sv_ecef.interpolate(t_c)[1]))
+    else:
+        v = max(raw.radar.platform_velocity_mps or 0.0, options.velocity_guess_mps)
+    return 2.0 * v / raw.radar.wavelength_m
 
 
 # --- stage 4 ---------------------------------------------------------------------------------------
@@ -385,25 +404,10 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
 
 # --- assemble --------------------------------------------------------------------------------------
 
-def max_doppler_hz(raw: RawProduct, options: DopplerOptions, geo: SceneGeometry | None, rate: RateStage) -> float:
-    """2 V / lam, the largest Doppler a target anywhere can have for a platform at speed V (relative to
-    the ground: the orbit's ECEF speed at the scene centre; without an orbit the largest of the product's
-    platform velocity, the velocity guess and the map-drift velocity)."""
-    lam = raw.radar.wavelength_m
-    if geo is not None:
-        t_c = 0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1])
-        v = float(np.linalg.norm(geo.orbit.sv_ecef.interpolate(t_c)[1]))
-    else:
-        md = rate.diagnostics.mapdrift
-        v = max(raw.radar.platform_velocity_mps or 0.0, options.velocity_guess_mps, md.velocity_mps if md else 0.0)
-    return 2.0 * v / lam
-
-
 def assemble(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, ambs: AmbiguityStage, fit: FitStage,
              rate: RateStage, geo: SceneGeometry | None, gain_steps: GainSteps | None,
              parameters: dict) -> PolyDoppler:
-    """The model, its block table and summary (scene values at the centre sample and time). Refuses an
-    absolute centroid beyond 2V/lam (:func:`max_doppler_hz`): a wrong PRF, wavelength or ambiguity."""
+    """The model, its block table and summary (scene values at the centre sample and time)."""
     radar = raw.radar
     prf = radar.prf_hz
     n_samples = raw.echo.shape[1]
@@ -411,11 +415,6 @@ def assemble(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, ambs:
     r_c = radar.first_range_m + 0.5 * (n_samples - 1) * C / (2.0 * radar.range_sampling_rate_hz)
     t_c = float(0.5 * (raw.azimuth_time[0] + raw.azimuth_time[-1]))
     fdc_c = float(fit.fdc_poly(r_c, t_c))
-    f_max = max_doppler_hz(raw, options, geo, rate)
-    if not abs(fdc_c) <= f_max:
-        err = ConfigError if ambs.source == "user" else ProductError
-        raise err(f"absolute Doppler centroid {fdc_c:.6g} Hz is beyond the largest Doppler the platform can produce "
-                  f"(2V/lam = {f_max:.6g} Hz): the PRF ({prf:.6g} Hz), the wavelength or the ambiguity is wrong")
     gdiag = GeometryDiagnostics()
     if geo is not None:
         other = geo.fdc("closed" if options.fdc_model == "vector" else "vector", False, Rg, T)

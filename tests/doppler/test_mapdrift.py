@@ -75,4 +75,6 @@ def test_mapdrift_rate_follows_inverse_range_over_the_swath(airborne_raw, tmp_pa
     assert 0 < md.velocity_sigma_mps < 5e-4 * v
     assert abs(md.velocity_mps - v) < 4 * md.velocity_sigma_mps
     write_doppler(tmp_path / "d.h5", m)
-    np.testing.assert_allclose(read_doppler(tmp_path / "d.h5").fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
+    back = read_doppler(tmp_path / "d.h5")
+    np.testing.assert_allclose(back.fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
+    assert back.summary.fr_info.mapdrift == md and back.summary == m.summary  # typed summary round trip
