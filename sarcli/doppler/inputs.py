@@ -37,7 +37,7 @@ WAVELENGTH_TOLERANCE = 1e-3
 
 
 def _positive(v: object) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) and float(v) > 0
 
 
 def check_raw(raw: RawProduct) -> None:

@@ -305,7 +305,7 @@ def doppler_rate(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, f
     Rg, T = bb.range_m, bb.time_s
     fr_blk, fr_seed, look_seed, rho_seed = (np.full(bb.shape, np.nan) for _ in range(4))
     fdc_fit = fit.fdc_poly(Rg, T)
-    method = options.fr_method
+    method: str = options.fr_method
     if method == "auto":
         method = "orbit" if geo is not None else ("mapdrift" if can_compress(raw) else "nominal")
     if method in ("orbit", "seed") and geo is None:

@@ -59,7 +59,8 @@ def _read_poly(f, name: str, path) -> Poly2D:
     g = f[name]
     coef = require(g, "coef", path, shape_rank=2)[()]
     try:
-        return Poly2D(coef, *(float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys")), int(g.attrs.get("x_power", 0)))
+        x0, xs, y0, ys = (float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys"))
+        return Poly2D(coef, x0, xs, y0, ys, int(g.attrs.get("x_power", 0)))
     except KeyError as e:
         raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
 
