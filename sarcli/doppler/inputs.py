@@ -71,10 +71,12 @@ def check_raw(raw: RawProduct) -> None:
         raise ProductError(f"azimuth_time has {bad.size} non-finite value(s) (first at line {bad[0]})")
     pulses = np.diff(t) * prf  # pulse intervals between consecutive lines, 1 for a regular train
     median = float(np.median(pulses))
+    if not median > 0:
+        raise ProductError("azimuth times do not increase from line to line (reversed or constant times)")
     if abs(median - 1.0) > SPACING_TOLERANCE:
-        rate = prf / median if median > 0 else float("nan")
-        raise ProductError(f"PRF {prf:.6g} Hz does not match the azimuth times (one line every "
-                           f"{1.0 / rate if rate > 0 else float('nan'):.6g} s, i.e. {rate:.6g} lines/s)")
+        rate = prf / median
+        raise ProductError(f"PRF {prf:.6g} Hz does not match the azimuth times (one line every {1.0 / rate:.6g} s, "
+                           f"i.e. {rate:.6g} lines/s)")
     off = np.flatnonzero(np.abs(pulses - 1.0) > SPACING_TOLERANCE)
     if off.size:
         k = int(off[0]) + 1

@@ -94,7 +94,7 @@ def test_cli_on_the_real_vancouver_block(cli, shared_data, tmp_path):
     assert r.exit_code == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["fdc_baseband_hz"] == pytest.approx(487.0, abs=5.0)
-    assert d["ambiguity"] == -6 and d["ambiguity_source"] == "data"
+    assert d["ambiguity"] == -6 and d["ambiguity_source"] == "data" and d["ambiguity_resolved"] is True
     assert 0.3 < d["ambiguity_confidence"] < 0.9  # MLBF and MLCC disagree: not a certainty
     assert d["fr_method"] == "mapdrift"
     lam = 2.9979e8 / 5.3e9

@@ -39,7 +39,7 @@ def _times(raw: RawProduct, t: np.ndarray) -> RawProduct:
     ("zero_prf", "PRF must be a positive number"),
     ("gap", "line 200 comes 2 pulse intervals after line 199"),
     ("jitter", "not a regular pulse train"),
-    ("reversed", "PRF .* does not match the azimuth times"),
+    ("reversed", "azimuth times do not increase"),
     ("short_times", "azimuth_time has shape"),
     ("long_pulse", "the pulse is longer than the pulse repetition interval"),
     ("wavelength", "wavelength .* and carrier .* disagree"),
