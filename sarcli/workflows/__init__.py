@@ -15,4 +15,6 @@ are registered in :data:`WORKFLOWS` by step name.
 
 from sarcli.registry import Registry
 
-WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {})
+WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
+    "doppler": "sarcli.workflows.doppler",
+})
