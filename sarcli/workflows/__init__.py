@@ -15,4 +15,14 @@ are registered in :data:`WORKFLOWS` by step name.
 
 from sarcli.registry import Registry
 
-WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {})
+WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
+    "gbsar_simulate": "sarcli.workflows.gbsar_simulate",
+    "gbsar_plan": "sarcli.workflows.gbsar_plan",
+    "gbsar_focus": "sarcli.workflows.gbsar_focus",
+    "gbsar_interfere": "sarcli.workflows.gbsar_interfere",
+    "gbsar_coherence": "sarcli.workflows.gbsar_coherence",
+    "gbsar_polarimetry": "sarcli.workflows.gbsar_polarimetry",
+    "gbsar_scan": "sarcli.workflows.gbsar_scan",
+    "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
+    "gbsar_repeat": "sarcli.workflows.gbsar_repeat",
+})
