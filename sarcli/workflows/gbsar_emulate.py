@@ -11,6 +11,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 from sarcli.acquire.emulator import Emulator, scene_source
 from sarcli.errors import ConfigError
@@ -28,7 +29,7 @@ class Config:
     scene: Path | None = None
     faults: str = ""
     time_scale: float = 1.0
-    switch: str = "none"
+    switch: Literal["none", "grbl", "11713a"] = "none"
     pol: str = "VV"
     machine_zero_m: float | None = None
     height_m: float | None = None
