@@ -200,9 +200,8 @@ def test_products_are_reproducible(cli, tmp_path, monkeypatch):
     assert blobs[0] == blobs[1]
 
 
-def test_manual_examples_are_self_contained():
-    """Every input of an example in the GB-SAR manual (docs/gbsar.md) is a shipped sample or made by an
-    earlier line."""
+def test_readme_examples_are_self_contained():
+    """Every input of an example in the GB-SAR manual (docs/gbsar.md) is a shipped sample or made by an earlier line."""
     import re
     import shlex
     from pathlib import Path
