@@ -17,4 +17,13 @@ from sarcli.registry import Registry
 
 WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "doppler": "sarcli.workflows.doppler",
+    "gbsar_coherence": "sarcli.workflows.gbsar_coherence",
+    "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
+    "gbsar_focus": "sarcli.workflows.gbsar_focus",
+    "gbsar_interfere": "sarcli.workflows.gbsar_interfere",
+    "gbsar_plan": "sarcli.workflows.gbsar_plan",
+    "gbsar_polarimetry": "sarcli.workflows.gbsar_polarimetry",
+    "gbsar_repeat": "sarcli.workflows.gbsar_repeat",
+    "gbsar_scan": "sarcli.workflows.gbsar_scan",
+    "gbsar_simulate": "sarcli.workflows.gbsar_simulate",
 })
