@@ -97,6 +97,7 @@ def _scene():
 def section_estimators(out: dict, raw) -> str:
     from sarcli.doppler.api import estimate_doppler
     from sarcli.doppler.cde import block_correlation
+    from sarcli.doppler.options import DopplerOptions
     from sarcli.doppler.rangecomp import range_compress_extended
 
     tf, tr = raw.truth["doppler_centroid_hz"], raw.truth["doppler_rate_hz_per_s"]
@@ -107,17 +108,17 @@ def section_estimators(out: dict, raw) -> str:
                                                           2048, 128)}
     rows, data = [], []
     for est in ("cde", "sde", "rc-cde"):
-        m = estimate_doppler(raw, estimator=est)
+        m = estimate_doppler(raw, DopplerOptions(estimator=est))
         e = m.fdc(rho, 0.0) - tf
         t_est = best_time(timers[est], repeat=3)
-        t_all = best_time(lambda est=est: estimate_doppler(raw, estimator=est), repeat=1)
+        t_all = best_time(lambda est=est: estimate_doppler(raw, DopplerOptions(estimator=est)), repeat=1)
         rms = float(np.sqrt(np.mean(e**2)))
         rows.append([est, rms, 100 * rms / prf, float(np.max(np.abs(m.fr(rho, 0.0) / tr - 1))), t_est * 1e3, t_all])
         data.append({"estimator": est, "fdc_rms_hz": rms, "fdc_rms_pct_prf": 100 * rms / prf,
                      "t_estimator_ms": t_est * 1e3, "t_pipeline_s": t_all})
-    m = estimate_doppler(raw, fr_method="mapdrift")
+    m = estimate_doppler(raw, DopplerOptions(fr_method="mapdrift"))
     md_err = float(np.max(np.abs(m.fr(rho, 0.0) / tr - 1)))
-    md = m.summary["fr_info"]["mapdrift"]
+    md = m.summary.fr_info.mapdrift.to_dict()
     air = _mapdrift_airborne()
     out["estimators"] = data
     out["mapdrift_fr_max_rel"] = md_err
@@ -140,14 +141,15 @@ def section_estimators(out: dict, raw) -> str:
 def _mapdrift_airborne() -> dict:
     """Map-drift effective velocity on the airborne clutter scene (true fr = -2 V^2/(lam R), V = 2000 m/s)."""
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
     from tests.doppler.conftest import SCENES, simulate_text
 
     raw = simulate_text((SCENES / "airborne_clutter.toml").read_text())
     raw = dataclasses.replace(raw, radar=dataclasses.replace(raw.radar, platform_velocity_mps=None))
     rho, lam = raw.slant_range(), raw.radar.wavelength_m
-    m = estimate_doppler(raw, velocity_guess_mps=2200.0, ambiguity_value=0)
+    m = estimate_doppler(raw, DopplerOptions(velocity_guess_mps=2200.0, ambiguity_value=0))
     far = np.linspace(0.5 * rho[0], 2.0 * rho[-1], 50)
-    md = m.summary["fr_info"]["mapdrift"]
+    md = m.summary.fr_info.mapdrift.to_dict()
     return {"velocity_mps": md["velocity_mps"], "velocity_sigma_mps": md["velocity_sigma_mps"],
             "range_m": [float(rho[0]), float(rho[-1])],
             "swath_max_rel": float(np.max(np.abs(m.fr(rho, 0.0) / raw.truth["doppler_rate_hz_per_s"] - 1))),
@@ -219,24 +221,25 @@ def section_hermite(out: dict, raw) -> str:
 def _stability(raw, estimator: str, gain_steps: str) -> dict:
     """512- vs 1536-line baseband centroids per 128-sample range block, through estimate_doppler."""
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
 
     prf = raw.radar.prf_hz
     t0 = time.perf_counter()
-    m5 = estimate_doppler(raw, az_block=512, estimator=estimator, gain_steps=gain_steps)
+    m5 = estimate_doppler(raw, DopplerOptions(az_block=512, estimator=estimator, gain_steps=gain_steps))
     t5 = time.perf_counter() - t0
-    m15 = estimate_doppler(raw, az_block=1536, estimator=estimator, gain_steps=gain_steps)
+    m15 = estimate_doppler(raw, DopplerOptions(az_block=1536, estimator=estimator, gain_steps=gain_steps))
     f5, f15 = m5.blocks["fdc_baseband_hz"].reshape(3, -1), m15.blocks["fdc_baseband_hz"].reshape(1, -1)
     q5, q15 = m5.blocks["quality"].reshape(3, -1), m15.blocks["quality"].reshape(1, -1)
     v5, v15 = m5.blocks["valid"].reshape(3, -1), m15.blocks["valid"].reshape(1, -1)
     d = np.mod(f5 - f15 + prf / 2, prf) - prf / 2
     good = (q15 >= np.median(q15)) & (q5 >= 0.2) & v5 & v15
     res = {"diff_hz": d, "good": good, "quality_1536": q15[0], "baseband_1536_hz": f15[0], "t_512_s": t5,
-           "scene_baseband_hz": m15.summary["fdc_baseband_hz"], "fdc_hz": m15.summary["fdc_hz"],
+           "scene_baseband_hz": m15.summary.fdc_baseband_hz, "fdc_hz": m15.summary.fdc_hz,
            "within_10hz_fraction": float(np.mean(np.abs(d[good]) < 10.0)) if np.any(good) else float("nan"),
-           "n_good": int(good.sum()), "gain_steps": m15.summary.get("gain_steps")}
+           "n_good": int(good.sum()), "gain_steps": m15.summary.gain_steps}
     if estimator == "lb":
-        s5 = np.array(m5.summary["look_balance"]["sigma_hz"])
-        s15 = np.array(m15.summary["look_balance"]["sigma_hz"])
+        s5 = np.array(m5.summary.estimator_info["sigma_hz"])
+        s15 = np.array(m15.summary.estimator_info["sigma_hz"])
         res["sigma_diff_hz"] = np.hypot(s5, s15)
     return res
 
@@ -246,6 +249,7 @@ def section_real(out: dict) -> str:
     if not mat.exists():
         return "## F. Real data\n\n../shared/data not available in this run.\n"
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
     from sarcli.io.matlab import read_matlab_block
 
     raw = read_matlab_block(mat, par)
@@ -260,9 +264,9 @@ def section_real(out: dict) -> str:
     lb_rows = [[j, *(lb["diff_hz"][i, j] for i in range(3)), *(lb["sigma_diff_hz"][i, j] for i in range(3))]
                for j in range(lb["diff_hz"].shape[1])]
     t0 = time.perf_counter()
-    m = estimate_doppler(raw, az_block=1536)
+    m = estimate_doppler(raw, DopplerOptions(az_block=1536))
     t_est = time.perf_counter() - t0
-    s = m.summary
+    s = m.summary.to_dict()
     out["real"] = {"variants": variants, "summary": s, "t_estimate_s": t_est}
     summary_rows = [[k, v["scene_baseband_hz"], v["fdc_hz"], v["n_good"], 100 * v["within_10hz_fraction"],
                      float(np.median(np.abs(v["diff_hz"][v["good"]]))) if v["n_good"] else float("nan"), v["t_512_s"]]
@@ -298,6 +302,7 @@ def section_real(out: dict) -> str:
 def section_contrast(out: dict) -> str:
     """CDE vs look balance on the simulated coast, 512-line blocks, against the truth."""
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
     from tests.doppler.conftest import SCENES, simulate_text
 
     raw = simulate_text((SCENES / "rs1_coast.toml").read_text())
@@ -306,7 +311,7 @@ def section_contrast(out: dict) -> str:
     for est in ("cde", "lb"):
         for az in (512, 1536):
             t0 = time.perf_counter()
-            m = estimate_doppler(raw, estimator=est, az_block=az, rg_block=128)
+            m = estimate_doppler(raw, DopplerOptions(estimator=est, az_block=az, rg_block=128))
             t = time.perf_counter() - t0
             b = m.blocks
             err = b["fdc_hz"] - np.interp(b["range_m"], rho, tf)
@@ -323,6 +328,7 @@ def section_contrast(out: dict) -> str:
 
 def section_examples(out: dict) -> str:
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
     from sarcli.sim.scene import parse_scene
     from sarcli.sim.stripmap import simulate
     from tests.doppler.conftest import scene_text, simulate_text
@@ -335,8 +341,8 @@ def section_examples(out: dict) -> str:
         tf, rho, prf = raw.truth["doppler_centroid_hz"], raw.slant_range(), raw.radar.prf_hz
         tt = float(raw.truth["doppler_truth_time_s"])
         for blocks in ((2048, 128), (512, 96)):
-            m = estimate_doppler(raw, az_block=blocks[0], rg_block=blocks[1])
-            s = m.summary
+            m = estimate_doppler(raw, DopplerOptions(az_block=blocks[0], rg_block=blocks[1]))
+            s = m.summary.to_dict()
             f_true = float(np.interp(s["scene_range_m"], rho, tf))
             rms = float(np.sqrt(np.mean((m.fdc(rho, tt) - tf) ** 2)))
             rows.append([name, f"{raw.echo.shape[0]} x {raw.echo.shape[1]}", f"{blocks[0]} x {blocks[1]}",

@@ -10,6 +10,10 @@ call (scipy.fft scratch is not counted), next to Table 1's ``N_Rfft x N_xfft x 8
 
 Goals (issue 6): outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
 everywhere at no more than twice DF's time plus the near-range part.
+
+PS coherence (issue 15): ``sarcli gbsar coherence`` on N image products of the outdoor grid, read by
+blocks of rows from their HDF5 files, against the former whole-stack computation (every image read,
+``np.stack``): wall time and tracemalloc peak of each.
 """
 
 from __future__ import annotations
@@ -147,10 +151,59 @@ def _bench_config(name: str, cfg: dict, rows: list, core_rows: list) -> dict:
     return cfg_out
 
 
+def _bench_coherence(n_images: int = 24, shape: tuple[int, int] = (1025, 469)) -> tuple[dict, list]:
+    """Block-wise PS coherence vs the whole stack on ``n_images`` outdoor-sized image products."""
+    import tempfile
+    from pathlib import Path
+
+    from sarcli.gbsar.interferometry import support
+    from sarcli.gbsar.timeseries import ps_series, select_ps, temporal_coherence
+    from sarcli.io.gbsar_image import read_gbsar_image, write_gbsar_image
+    from sarcli.model.gbsar import GbsarImage
+    from sarcli.workflows import gbsar_coherence
+
+    rng = np.random.default_rng(3)
+    stable = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) * (rng.uniform(size=shape) < 0.01) * 30
+    with tempfile.TemporaryDirectory(dir=Path(__file__).parent) as tmp:
+        paths = []
+        for k in range(n_images):
+            img = (stable + rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(np.complex64)
+            im = GbsarImage(image=img[None], range_m=np.arange(shape[0]) * 0.586, azimuth_m=np.arange(shape[1]) * 0.3,
+                            algorithm_map=np.ones(shape, np.uint8), polarizations=("VV",), algorithm="auto",
+                            center_frequency_hz=5.3e9, frequency_step_hz=125e3, n_freq=1601, rail_height_m=21.0,
+                            rail_centre_m=0.0, rail_length_m=5.0, epoch_utc="2026-01-01T00:00:00Z",
+                            scan_time_s=600.0 * k)
+            paths.append(Path(tmp) / f"i{k}.h5")
+            write_gbsar_image(paths[-1], im)
+        cfg = gbsar_coherence.Config(images=tuple(paths), output=Path(tmp) / "ps.h5", threshold=0.9)
+
+        def blockwise():
+            gbsar_coherence.run(cfg)
+
+        def whole_stack():
+            imgs = [read_gbsar_image(p) for p in paths]
+            stack = np.stack([im.pol("VV") for im in imgs])
+            ok = np.logical_and.reduce([support(im, "VV") for im in imgs])
+            gamma = np.where(ok, temporal_coherence(stack), np.nan).astype(np.float32)
+            rows, cols = select_ps(gamma, np.mean(np.abs(stack), axis=0), 0.9, 40.0)
+            ps_series(stack[:, rows, cols].T, imgs[0].wavelength_m)
+
+        out = {"n_images": n_images, "shape": list(shape), "image_bytes": int(np.prod(shape)) * 8,
+               "stack_bytes": int(np.prod(shape)) * 8 * n_images,
+               "block_rows": max(1, gbsar_coherence.BLOCK_BYTES // (n_images * shape[1] * 8 * 4))}
+        for name, fn in (("blockwise", blockwise), ("whole_stack", whole_stack)):
+            out[name] = {"seconds": best_time(fn, repeat=2, warmup=1), "peak_numpy_bytes": _mem_peak(fn)}
+    row = [n_images, f"{shape[0]} x {shape[1]}", out["stack_bytes"] / 2**20, out["block_rows"],
+           out["blockwise"]["seconds"], out["blockwise"]["peak_numpy_bytes"] / 2**20,
+           out["whole_stack"]["seconds"], out["whole_stack"]["peak_numpy_bytes"] / 2**20]
+    return out, row
+
+
 def main() -> None:
     rows, core_rows, data = [], [], {"configs": {}}
     for name, cfg in CONFIGS.items():
         data["configs"][name] = _bench_config(name, cfg, rows, core_rows)
+    data["coherence"], coh_row = _bench_coherence()
     md = ["# GB-SAR focusing benchmark (DF / RD / BP / auto)\n",
           f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, 2 shared cores, load average "
           f"{os.getloadavg()[0]:.1f} at the end. Targets with the sinc "
@@ -167,7 +220,14 @@ def main() -> None:
           "array is half of Table 1's; RD runs on 2x oversampled range bins, so its output array is Table 1's.\n",
           markdown_table(["config", "DF array", "Table 1 DF MB", "DF array MB", "DF numpy peak MB",
                           "RC + DF core ms", "geometric correction ms", "RD array", "Table 1 RD MB", "RD array MB",
-                          "RD numpy peak MB (output + 256-row blocks)", "RD core s"], core_rows)]
+                          "RD numpy peak MB (output + 256-row blocks)", "RD core s"], core_rows),
+          "\n## PS coherence: block-wise vs whole stack\n",
+          "`gbsar coherence` reads every image product by blocks of rows (one block of each image at a time; "
+          "the coherence and mean-amplitude maps are kept whole) instead of stacking all images; same result "
+          "bit for bit (tests/gbsar/test_workflows.py). Time best of 2 (HDF5 reads and the product write "
+          "included in both).\n",
+          markdown_table(["images", "grid", "stack MB", "block rows", "block-wise s", "block-wise numpy peak MB",
+                          "whole stack s", "whole stack numpy peak MB"], [coh_row])]
     write_results("bench_gbsar", "\n".join(md), data)
     _plot(data)
 

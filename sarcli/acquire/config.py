@@ -4,14 +4,18 @@ Everything that can be checked without touching an instrument is checked here, s
 configuration gives one clear error before anything moves: frequency range (30 kHz..3 GHz, 6 GHz
 with option 006), allowed points and IF bandwidths, power range, polarizations vs. switch,
 rail travel within ``[0, max_travel_m]``. Units are SI (Hz, m, s, dBm); angles in degrees.
+
+The file's tables (``[vna]``, ``[rail]``, ``[polarization]``, ``[site]``, ``[antenna]``) are the frozen
+dataclasses below, read by the one configuration helper :func:`sarcli.config.from_mapping`: an
+unknown table or key, or a value of the wrong type, is one :class:`~sarcli.errors.ConfigError` line
+naming the file and the table (``scan.toml [vna]: unknown option(s) points_typo; known: ...``).
 """
 
 from __future__ import annotations
 
 import math
 import re
-import tomllib
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +24,7 @@ import numpy as np
 from sarcli.acquire import vna8753 as vna
 from sarcli.acquire.motion import move_time
 from sarcli.acquire.polswitch import SWITCH_KINDS
+from sarcli.config import from_mapping, load_toml
 from sarcli.errors import ConfigError
 from sarcli.io.scan import POLARIZATIONS
 from sarcli.model.gbsar import Antenna, Site
@@ -82,7 +87,7 @@ class PolConfig:
 class ScanConfig:
     vna: VnaConfig = field(default_factory=VnaConfig)
     rail: RailConfig = field(default_factory=RailConfig)
-    pol: PolConfig = field(default_factory=PolConfig)
+    polarization: PolConfig = field(default_factory=PolConfig)
     site: Site = field(default_factory=Site)
     antenna: Antenna = field(default_factory=Antenna)
 
@@ -96,7 +101,7 @@ class ScanConfig:
         v, r = self.vna, self.rail
         return {"start_hz": float(v.start_hz), "stop_hz": float(v.stop_hz), "points": int(v.points),
                 "if_bandwidth_hz": float(v.if_bandwidth_hz), "power_dbm": float(v.power_dbm),
-                "parameter": v.parameter, "polarizations": ",".join(self.pol.polarizations),
+                "parameter": v.parameter, "polarizations": ",".join(self.polarization.polarizations),
                 "rail_start_m": float(r.start_m), "rail_step_m": float(r.step_m),
                 "rail_count": int(r.count), "rail_height_m": float(r.height_m),
                 "rail_machine_zero_m": float(r.machine_zero_m)}
@@ -106,53 +111,24 @@ _SECTIONS = {"vna": VnaConfig, "rail": RailConfig, "polarization": PolConfig, "s
              "antenna": Antenna}
 
 
-def _build(cls, table: dict[str, Any], where: str):
-    known = {f.name: f for f in fields(cls)}
-    kwargs = {}
-    for key, value in table.items():
-        if key not in known:
-            raise ConfigError(f"{where}: unknown key '{key}' (known: {', '.join(known)})")
-        default = getattr(cls(), key)
-        if isinstance(default, tuple):
-            value = tuple(value) if isinstance(value, list) else tuple(str(value).split(","))
-        elif isinstance(default, bool):
-            if not isinstance(value, bool):
-                raise ConfigError(f"{where}.{key} must be true or false")
-        elif isinstance(default, int | float):
-            if not isinstance(value, int | float) or isinstance(value, bool):
-                raise ConfigError(f"{where}.{key} must be a number, got {value!r}")
-            value = type(default)(value)
-        kwargs[key] = value
-    return cls(**kwargs)
-
-
 def load_config(path: str | Path | None, overrides: dict[str, dict[str, Any]] | None = None) -> ScanConfig:
-    """Read ``path`` (or defaults), apply ``overrides`` ({section: {key: value}}), validate."""
-    data: dict[str, Any] = {}
-    if path is not None:
-        p = Path(path)
-        if not p.is_file():
-            raise ConfigError(f"configuration {p} not found")
-        try:
-            data = tomllib.loads(p.read_text())
-        except tomllib.TOMLDecodeError as e:
-            raise ConfigError(f"{p}: not valid TOML ({e})") from None
+    """Read ``path`` (or defaults), apply ``overrides`` ({table: {key: value}}, None values ignored),
+    check every table with :func:`sarcli.config.from_mapping`, then validate the plan."""
+    source = str(path) if path is not None else "acquisition settings"
+    data: dict[str, Any] = load_toml(path) if path is not None else {}
     for section, values in (overrides or {}).items():
-        data.setdefault(section, {}).update({k: v for k, v in values.items() if v is not None})
-    unknown = set(data) - set(_SECTIONS)
-    if unknown:
-        raise ConfigError(f"unknown configuration section(s) {', '.join(sorted(unknown))} "
-                          f"(known: {', '.join(_SECTIONS)})")
-    parts = {name: _build(cls, data.get(name, {}), name) for name, cls in _SECTIONS.items()}
-    cfg = ScanConfig(vna=parts["vna"], rail=parts["rail"], pol=parts["polarization"],
-                     site=parts["site"], antenna=parts["antenna"])
+        given = {k: v for k, v in values.items() if v is not None}
+        if given and isinstance(data.setdefault(section, {}), dict):
+            data[section].update(given)
+    parts = {k: from_mapping(_SECTIONS[k], v, f"{source} [{k}]") if k in _SECTIONS else v for k, v in data.items()}
+    cfg = from_mapping(ScanConfig, parts, source)
     validate(cfg)
     return cfg
 
 
 def validate(cfg: ScanConfig, max_frequency_hz: float | None = None, max_travel_mm: float | None = None) -> None:
     """Raise ConfigError on the first problem. Instrument limits, once known, tighten the checks."""
-    v, r, p = cfg.vna, cfg.rail, cfg.pol
+    v, r, p = cfg.vna, cfg.rail, cfg.polarization
     fmax = min(v.max_frequency_hz, max_frequency_hz or math.inf)
     if not (vna.MIN_FREQUENCY_HZ <= v.start_hz < v.stop_hz <= fmax):
         raise ConfigError(f"frequency range {format_frequency(v.start_hz)}-{format_frequency(v.stop_hz)} is "
@@ -198,14 +174,6 @@ def validate(cfg: ScanConfig, max_frequency_hz: float | None = None, max_travel_
         raise ConfigError(f"rail travel {lo_m:g}..{hi_m:g} m (machine X) is beyond the limits 0..{travel:g} m")
 
 
-def with_overrides(cfg: ScanConfig, **sections: dict[str, Any]) -> ScanConfig:
-    """A copy with some fields replaced (e.g. ``with_overrides(cfg, rail={"count": 3})``)."""
-    parts = {"vna": cfg.vna, "rail": cfg.rail, "pol": cfg.pol, "site": cfg.site, "antenna": cfg.antenna}
-    for name, values in sections.items():
-        parts[name] = replace(parts[name], **values)
-    return ScanConfig(**parts)
-
-
 @dataclass(frozen=True)
 class PlanEstimate:
     n_stops: int
@@ -220,12 +188,12 @@ def estimate(cfg: ScanConfig, remaining: int | None = None) -> PlanEstimate:
     """Duration of the scan (or of its ``remaining`` stops): sweeps + data + moves + settling."""
     v, r = cfg.vna, cfg.rail
     n = r.count if remaining is None else remaining
-    n_pol = len(cfg.pol.polarizations)
+    n_pol = len(cfg.polarization.polarizations)
     sweep = vna.estimated_sweep_time(v.points, v.if_bandwidth_hz)
     bytes_per_point = 50 if v.data_format == "FORM4" else 2 * (4 if v.data_format == "FORM2" else 8)
     transfer = v.points * bytes_per_point / 50e3  # ~50 kB/s through GPIB + USB [U]
     step_move = move_time(r.step_m * 1000.0, r.feed_mm_min / 60.0, r.accel_mm_s2)
-    per_stop = n_pol * (sweep + transfer + (cfg.pol.settle_s if n_pol > 1 else 0.0)) + step_move + r.settle_s
+    per_stop = n_pol * (sweep + transfer + (cfg.polarization.settle_s if n_pol > 1 else 0.0)) + step_move + r.settle_s
     end = r.start_m + r.step_m * (r.count - 1)
     return PlanEstimate(n, n * n_pol, sweep, step_move, n * per_stop, (r.start_m, end))
 
@@ -233,7 +201,7 @@ def estimate(cfg: ScanConfig, remaining: int | None = None) -> PlanEstimate:
 def to_attrs(cfg: ScanConfig) -> dict[str, Any]:
     """Flat JSON-able attributes for the scan file's /instrument group."""
     out: dict[str, Any] = {}
-    for prefix, obj in (("vna", cfg.vna), ("rail", cfg.rail), ("pol", cfg.pol)):
+    for prefix, obj in (("vna", cfg.vna), ("rail", cfg.rail), ("pol", cfg.polarization)):  # file attribute names
         for k, val in asdict(obj).items():
             out[f"{prefix}_{k}"] = ",".join(val) if isinstance(val, tuple | list) else val
     return out

@@ -80,7 +80,7 @@ def connect(cfg: ScanConfig, vna_port: str, rail_port: str,
 
 
 def make_switch(cfg: ScanConfig, rail: GrblRail, gpib: Prologix) -> PolSwitch:
-    p = cfg.pol
+    p = cfg.polarization
     if p.switch == "grbl":
         return GrblPinSwitch(rail, settle_s=p.settle_s)
     if p.switch == "11713a":
@@ -90,13 +90,13 @@ def make_switch(cfg: ScanConfig, rail: GrblRail, gpib: Prologix) -> PolSwitch:
 
 def scan_template(cfg: ScanConfig, identity: dict[str, Any], epoch_utc: str) -> Scan:
     """An empty scan carrying the frequency axis, polarizations, site and settings."""
-    n_pol, n_f = len(cfg.pol.polarizations), cfg.vna.points
+    n_pol, n_f = len(cfg.polarization.polarizations), cfg.vna.points
     instrument = {**to_attrs(cfg), **{k: v for k, v in identity.items() if v is not None},
                   "pol_convention": "TX letter then RX letter",
                   **{f"identity_{k}": v for k, v in cfg.identity().items()}}
     return Scan(s21=np.zeros((n_pol, 0, n_f), np.complex64), frequency=cfg.vna_settings().frequencies(),
                 rail_position=np.zeros(0), rail_height=np.zeros(0),
-                polarizations=tuple(cfg.pol.polarizations), epoch_utc=epoch_utc, site=cfg.site,
+                polarizations=tuple(cfg.polarization.polarizations), epoch_utc=epoch_utc, site=cfg.site,
                 antenna=cfg.antenna, instrument=instrument, source="measured", status="interrupted",
                 n_planned=cfg.rail.count)
 
@@ -144,7 +144,7 @@ def run_scan(cfg: ScanConfig, inst: Instruments, writer: ScanWriter, epoch_utc: 
              on_stop: Callable[[int], None] | None = None,
              stop_requested: Callable[[], bool] | None = None) -> ScanResult:
     """Measure stops ``writer.n_complete .. count-1``; returns how it ended (never raises on faults)."""
-    r, pols = cfg.rail, cfg.pol.polarizations
+    r, pols = cfg.rail, cfg.polarization.polarizations
     positions = r.positions()
     t_epoch = _epoch_seconds(epoch_utc)
     stop = stop_requested or (lambda: False)

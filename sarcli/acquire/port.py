@@ -4,6 +4,10 @@ pyserial's own ``timeout`` is kept short and fixed (``poll_s``); every read here
 deadline (``time.monotonic()`` seconds) instead, so a caller can wait long (a sweep) while still
 checking a stop flag (Ctrl-C) every ``poll_s``. Any OS-level failure of the port (USB unplugged,
 pseudo-terminal closed) becomes :class:`~sarcli.acquire.errors.Disconnected`.
+
+pyserial is the optional dependency of the ``acquire`` extra (``pip install 'sarcli[acquire]'``; see
+docs/acquisition.md for why): without it this module still imports, and :func:`require_pyserial`
+(called before any work by the acquisition workflows, and by :class:`Port`) refuses in one line.
 """
 
 from __future__ import annotations
@@ -11,9 +15,20 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-import serial
-
 from sarcli.acquire.errors import Disconnected, InstrumentError, InstrumentTimeout, Interrupted
+from sarcli.errors import ConfigError
+
+try:
+    import serial
+except ImportError:  # the acquire extra is not installed: processing still works
+    serial = None
+
+
+def require_pyserial() -> None:
+    """One :class:`ConfigError` line when pyserial (the ``acquire`` extra) is not installed."""
+    if serial is None:
+        raise ConfigError("talking to instruments needs pyserial, which is not installed: "
+                          "pip install 'sarcli[acquire]' (or pip install pyserial)")
 
 
 class Port:
@@ -21,6 +36,7 @@ class Port:
 
     def __init__(self, path: str, name: str, baudrate: int = 115200, poll_s: float = 0.02,
                  stop_requested: Callable[[], bool] | None = None):
+        require_pyserial()
         self.path, self.name = path, name
         self._buf = bytearray()
         self._stop = stop_requested or (lambda: False)

@@ -53,7 +53,7 @@ def utc_now() -> str:
 
 def plan_summary(cfg: ScanConfig, remaining: int | None = None) -> dict[str, Any]:
     e = estimate(cfg, remaining)
-    return {"n_stops": e.n_stops, "n_sweeps": e.n_sweeps, "polarizations": list(cfg.pol.polarizations),
+    return {"n_stops": e.n_stops, "n_sweeps": e.n_sweeps, "polarizations": list(cfg.polarization.polarizations),
             "points": cfg.vna.points, "frequency_hz": [cfg.vna.start_hz, cfg.vna.stop_hz],
             "rail_m": list(e.travel_m), "sweep_s": e.sweep_s, "move_s": e.move_s,
             "duration_s": e.duration_s}

@@ -63,7 +63,7 @@ def unwrap_blocks(fdc_bb: np.ndarray, weight: np.ndarray, prf: float, x: np.ndar
     return np.where(np.isfinite(f), fu, np.nan)
 
 
-def resolve(fdc_bb: np.ndarray, fdc_unwrapped: np.ndarray, fdc_pred: np.ndarray, weight: np.ndarray,
+def resolve(fdc_bb: np.ndarray, fdc_unwrapped: np.ndarray, fdc_pred: np.ndarray | float, weight: np.ndarray,
             prf: float, half_tolerance: float = 0.02) -> AmbiguityResult:
     """Scene and per-block ambiguity from a predicted absolute centroid (orbit model or data-only).
 

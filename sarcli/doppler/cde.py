@@ -82,6 +82,14 @@ class BlockCorrelation:
         w = 2.0 * self.pairs * q**2 / (1.0 - q**2)
         return np.where(self.valid(noise_sigmas, min_quality), w, 0.0)
 
+    def scene_sum(self, mask: np.ndarray) -> tuple[complex, float]:
+        """(correlation, normalization) summed over the blocks in ``mask``: CDE (C, E); SDE the
+        arcsine-corrected coefficient weighted by the pairs, (sum rho N, sum N). |sum| / norm is the
+        scene quality and arg(sum) gives the scene centroid."""
+        if self.estimator == "sde":
+            return np.sum(np.where(mask, self.phase_rho() * self.pairs, 0)), float(np.sum(self.pairs[mask]))
+        return np.sum(np.where(mask, self.corr, 0)), float(np.sum(self.energy[mask]))
+
     def centres(self) -> tuple[np.ndarray, np.ndarray]:
         """(line centre, sample centre) of each block, as fractional indices (1-D per axis)."""
         return self.line0 + 0.5 * (self.n_lines - 1), self.sample0 + 0.5 * (self.n_samples - 1)

@@ -39,31 +39,13 @@ better one is chosen with confidence c_best * (1 - c_other); fewer than 2 usable
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from sarcli.doppler.ambiguity import rounding_confidence
 from sarcli.doppler.cde import block_correlation
 from sarcli.doppler.rangecomp import range_looks
+from sarcli.model.doppler_summary import DataOnlyEstimate
 from sarcli.model.raw import Radar
-
-
-@dataclass
-class DataOnlyEstimate:
-    """Absolute centroid estimate of one method with its ambiguity and confidence."""
-
-    method: str
-    fdc_hz: float
-    sigma_hz: float
-    ambiguity: int
-    confidence: float
-    block_fdc_hz: np.ndarray
-
-    def as_dict(self) -> dict:
-        return {"method": self.method, "fdc_hz": self.fdc_hz, "sigma_hz": self.sigma_hz,
-                "ambiguity": self.ambiguity, "confidence": self.confidence,
-                "block_fdc_hz": self.block_fdc_hz}
 
 
 def _scatter_stats(vals: np.ndarray, w: np.ndarray) -> tuple[float, float, float]:

@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from sarcli.errors import ConfigError
 from sarcli.io.images import atomic_path
 from sarcli.model.doppler import PolyDoppler
 
@@ -22,11 +23,13 @@ def plot_doppler(path: str | os.PathLike, model: PolyDoppler, title: str = "") -
     r, t, q = b["range_m"], b["azimuth_time_s"], b["quality"]
     ok = b["valid"].astype(bool) & ~b["outlier"].astype(bool)
     s = model.summary
+    if s is None:
+        raise ConfigError("plot_doppler needs a model with its summary (from estimate_doppler or read_doppler)")
     rr = np.linspace(r.min(), r.max(), 200)
     tt = np.linspace(t.min(), t.max(), 200)
     fig, ax = plt.subplots(2, 2, figsize=(11, 7), constrained_layout=True)
-    for j, (x, xs, xlabel, xc) in enumerate(((r / 1e3, rr, "slant range (km)", s["scene_time_s"]),
-                                               (t, tt, "azimuth time (s)", s["scene_range_m"]))):
+    for j, (x, xs, xlabel, xc) in enumerate(((r / 1e3, rr, "slant range (km)", s.scene_time_s),
+                                               (t, tt, "azimuth time (s)", s.scene_range_m))):
         for i, (key, fn, ylabel) in enumerate((("fdc_hz", model.fdc, "Doppler centroid (Hz)"),
                                                ("fr_hz_per_s", model.fr, "Doppler rate (Hz/s)"))):
             a = ax[i, j]
@@ -41,8 +44,9 @@ def plot_doppler(path: str | os.PathLike, model: PolyDoppler, title: str = "") -
             a.set_ylabel(ylabel)
             a.grid(alpha=0.3)
     fig.colorbar(sc, ax=ax, label="block quality |C|/E", shrink=0.6)
-    fig.suptitle(title or (f"fdc {s['fdc_hz']:.1f} Hz (ambiguity {s['ambiguity']}, {s['ambiguity_source']}, "
-                           f"confidence {s['ambiguity_confidence']:.2f}), fr {s['fr_hz_per_s']:.2f} Hz/s"))
+    resolved = "" if s.ambiguity_resolved else ", NOT RESOLVED"
+    fig.suptitle(title or (f"fdc {s.fdc_hz:.1f} Hz (ambiguity {s.ambiguity}, {s.ambiguity_source}, "
+                           f"confidence {s.ambiguity_confidence:.2f}{resolved}), fr {s.fr_hz_per_s:.2f} Hz/s"))
     with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, dpi=100, format="png")
     plt.close(fig)

@@ -18,7 +18,18 @@ import scipy.fft as sfft
 
 from sarcli.errors import SarcliError
 from sarcli.focus.rangecomp import chirp_band, range_filter, reference_pulse
-from sarcli.model.raw import Radar
+from sarcli.model.raw import Radar, RawProduct
+
+#: samples beyond the pulse a swath needs before range compression is worth it (RC-CDE, MLCC/MLBF, map-drift)
+MIN_EXTRA_SAMPLES = 16
+
+
+def can_compress(raw: RawProduct) -> bool:
+    """Whether the swath is longer than the pulse (replica, else pulse length x sampling rate) by at
+    least ``MIN_EXTRA_SAMPLES``: the condition of every range-compressed estimator."""
+    n_ref = raw.replica.size if raw.replica is not None and raw.replica.size > 1 else int(
+        round(raw.radar.pulse_length_s * raw.radar.range_sampling_rate_hz))
+    return raw.echo.shape[1] > n_ref + MIN_EXTRA_SAMPLES
 
 
 def _spectrum(echo: np.ndarray, radar: Radar, replica: np.ndarray | None):

@@ -21,20 +21,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from sarcli.errors import SarcliError
 from sarcli.gbsar.rangecomp import RangeProfiles
+from sarcli.gbsar.windows import taper_at, taper_table
 
-WINDOW_CODE = {"none": 0, "hamming": 1, "hann": 2}
-
-
-_TABLE_N = 4097  # taper lookup table; linear interpolation error < 1e-7
 _W_MIN = 1e-9  # apertures whose taper weights sum below this (e.g. one stop on a Hann edge) give 0
-
-
-def taper_table(code: int) -> np.ndarray:
-    """Taper sampled on [0, 1] (``_TABLE_N`` points): 0 none, 1 Hamming, 2 Hann."""
-    t = np.linspace(0.0, 1.0, _TABLE_N)
-    return {0: np.ones_like(t), 1: 0.54 - 0.46 * np.cos(2 * np.pi * t), 2: 0.5 - 0.5 * np.cos(2 * np.pi * t)}[code]
 
 
 @njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
@@ -81,8 +71,8 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, table, out):
         out[p] = acc * frac / wsum if wsum > _W_MIN else 0j
 
 
-def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, wcode: int) -> np.ndarray:
-    """Plain-numpy reference of :func:`bp_kernel`."""
+def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_beam, taper_spec: str) -> np.ndarray:
+    """Plain-numpy reference of :func:`bp_kernel` (the taper evaluated exactly, not tabulated)."""
     rgrid = np.arange(prof.shape[1]) * dr
     a = np.maximum(xs[0], px - half_beam * pr)
     b = np.minimum(xs[-1], px + half_beam * pr)
@@ -91,7 +81,7 @@ def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_be
     wsum = np.zeros(px.shape)
     for i in range(prof.shape[0]):
         t = np.where(span > 0, (xs[i] - a) / np.where(span > 0, span, 1.0), 0.0)
-        w = {0: np.ones_like(t), 1: 0.54 - 0.46 * np.cos(2 * np.pi * t), 2: 0.5 - 0.5 * np.cos(2 * np.pi * t)}[wcode]
+        w = taper_at(taper_spec, t)
         r = np.sqrt((px - xs[i]) ** 2 + pr ** 2 + dz[i] ** 2)
         use = (valid[i] != 0) & (xs[i] >= a) & (xs[i] <= b) & (r < rgrid[-1])
         v = np.interp(r, rgrid, prof[i].real) + 1j * np.interp(r, rgrid, prof[i].imag)
@@ -108,9 +98,9 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_len
     """BP onto pixels at azimuth ``px`` and range ``pr`` (any equal shapes) -> complex64 of that shape.
 
     ``antenna_length_m`` = L_x limits each pixel's aperture to the beam footprint; None uses the whole rail.
+    ``azimuth_window``: a taper spec (:mod:`sarcli.gbsar.windows`) over each pixel's aperture.
     """
-    if azimuth_window not in WINDOW_CODE:
-        raise SarcliError(f"unknown window '{azimuth_window}' (use {', '.join(WINDOW_CODE)})")
+    table = taper_table(azimuth_window)
     px = np.asarray(px, np.float64)
     shape = px.shape
     flat_x = np.ascontiguousarray(px.ravel())
@@ -120,7 +110,7 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_len
     kc = 4 * np.pi / prof.wavelength_m
     half = prof.wavelength_m / (2 * antenna_length_m) if antenna_length_m else 1e30
     bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
-              half, taper_table(WINDOW_CODE[azimuth_window]), out)
+              half, table, out)
     return out.reshape(shape)
 
 

@@ -6,6 +6,10 @@ Grid: rows are range R0 from the rail line on the range-compression bins ``n c/(
 (``k = pixel_x/dx`` an integer, so RD samples fall on pixels exactly), centred on the rail.
 Every image has the phase convention ``-4 pi R0/lam`` at a scatterer (DF's ``-4 pi Rc/lam`` is
 converted, see :mod:`sarcli.gbsar.deramp`). ``algorithm_map``: 0 not covered, 1 DF, 2 RD, 3 BP.
+The stops are taken in increasing rail position (:func:`sarcli.gbsar.rail.ordered`: a scan measured
+backwards focuses to the same image; a rail with unknown or repeated positions is refused).
+Options: :class:`FocusOptions`, a frozen configuration (``sarcli.config.from_mapping`` builds it
+from a table); windows are taper specs of :mod:`sarcli.gbsar.windows`.
 """
 
 from __future__ import annotations
@@ -13,15 +17,19 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ConfigError, SarcliError
 from sarcli.gbsar.backprojection import backproject
 from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
-from sarcli.gbsar.rangecomp import RangeProfiles, range_compress
+from sarcli.gbsar.rail import ordered
+from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress
 from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
+from sarcli.gbsar.windows import parse_taper
+from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import Scan
 
 ALGORITHMS = ("auto", "df", "rd", "bp")
@@ -36,9 +44,27 @@ class Grid:
     azimuths: np.ndarray
 
 
-@dataclass
+MIN_RANGE_BINS = 4  # an image shallower than this many range bins is a mistake, not a product
+
+
+def _positive(name: str, flag: str, value: float | None, what: str) -> None:
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ConfigError(f"{name} ({flag}) must be a positive {what}, got {value:g}")
+
+
+@dataclass(frozen=True)
 class FocusOptions:
-    algorithm: str = "auto"
+    """How to focus (SI units; names as the ``sarcli gbsar focus`` options, whose flags the messages give).
+
+    ``algorithm``: auto | df | rd | bp; ``near``: auto's algorithm below the eq. 12 range;
+    ``range_window``/``azimuth_window``: taper specs over the frequencies / the stops (or, in BP, each
+    pixel's aperture); ``max_range_m``/``min_range_m``: image rows; ``pixel_x_m`` (a multiple of the
+    rail step), ``width_m``: image columns; ``criterion_rad``: the eq. 12 phase-error criterion;
+    ``n_xfft``: azimuth FFT size of DF/RD; ``*_oversample``: range (and DF azimuth) FFT oversampling;
+    ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect.
+    """
+
+    algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
     range_window: str = "hamming"
     azimuth_window: str = "hamming"
     max_range_m: float | None = None
@@ -46,13 +72,55 @@ class FocusOptions:
     pixel_x_m: float | None = None
     width_m: float | None = None
     criterion_rad: float = math.pi / 4
-    near: str = "bp"
+    near: Literal["bp", "rd"] = "bp"
     n_xfft: int | None = None
     bp_oversample: int = 4
     rd_oversample: int = 2
     df_oversample: int = 2
     beam_limited: bool = True
-    rd_reference: str = "sinc"
+    rd_reference: Literal["sinc", "rect"] = "sinc"
+
+    def __post_init__(self) -> None:
+        if self.algorithm not in ALGORITHMS:
+            raise ConfigError(f"unknown algorithm '{self.algorithm}' (use {', '.join(ALGORITHMS)})")
+        if self.near not in ("rd", "bp"):
+            raise ConfigError(f"the near-range algorithm (--near) must be 'rd' or 'bp', not '{self.near}'")
+        if self.rd_reference not in ("sinc", "rect"):
+            raise ConfigError(f"unknown RD reference '{self.rd_reference}' (use sinc or rect)")
+        parse_taper(self.range_window)
+        parse_taper(self.azimuth_window)
+        _positive("max_range_m", "--max-range", self.max_range_m, "range in metres")
+        if not (math.isfinite(self.min_range_m) and self.min_range_m >= 0):
+            raise ConfigError(f"min_range_m (--min-range) must be a finite range >= 0 m, got {self.min_range_m:g}")
+        _positive("pixel_x_m", "--pixel-x", self.pixel_x_m, "azimuth pixel in metres")
+        _positive("width_m", "--width", self.width_m, "azimuth extent in metres")
+        if not (math.isfinite(self.criterion_rad) and 0 < self.criterion_rad <= math.pi):
+            raise ConfigError(f"the DF phase-error criterion must be in (0, pi] rad, got {self.criterion_rad:g}")
+        if self.n_xfft is not None and self.n_xfft < 1:
+            raise ConfigError(f"n_xfft (--n-xfft) must be a positive FFT size, got {self.n_xfft}")
+        for name in ("bp_oversample", "rd_oversample", "df_oversample"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"{name} must be >= 1, got {getattr(self, name)}")
+
+
+def check_range_interval(scan: Scan, opts: FocusOptions) -> None:
+    """Refuse a range interval that holds fewer than MIN_RANGE_BINS range bins, before any focusing.
+
+    The bin is the range-compression sample spacing ``c / (2 N df)``, ``N = 2^ceil(log2 N_f)``
+    (N_Rfft of Table 1); ranges stop at R_max = c / (4 df).
+    """
+    df = check_sweep(scan.frequency)
+    dr = C_LIGHT / (2 * next_pow2(scan.frequency.size) * df)
+    r_max = C_LIGHT / (4 * df)
+    lo, hi = opts.min_range_m, opts.max_range_m
+    if lo > r_max - MIN_RANGE_BINS * dr:
+        raise ConfigError(f"--min-range {lo:g} m leaves fewer than {MIN_RANGE_BINS} range bins below the "
+                          f"unambiguous range R_max = {r_max:.4g} m of this sweep")
+    top = r_max if hi is None else min(hi, r_max)
+    if top - lo < MIN_RANGE_BINS * dr:
+        raise ConfigError(f"the range interval {lo:g}-{top:g} m holds fewer than {MIN_RANGE_BINS} range bins "
+                          f"of {dr:.3g} m (R_max {r_max:.4g} m): give --max-range at least "
+                          f"{lo + MIN_RANGE_BINS * dr:.3g} m and --min-range below it")
 
 
 @dataclass
@@ -128,12 +196,12 @@ def _rd(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions, 
 
 def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None = None,
                pols: tuple[str, ...] | None = None) -> Focused:
-    """Focus every polarization of ``scan`` (or ``pols``) with ``opts.algorithm``; report the choices."""
+    """Focus every polarization of ``scan`` (or ``pols``) with ``opts.algorithm``; report the choices.
+
+    The stops are focused in increasing rail position (:func:`sarcli.gbsar.rail.ordered`); the
+    report's ``skipped_stops`` are indices of the input scan."""
     opts = opts or FocusOptions()
-    if opts.algorithm not in ALGORITHMS:
-        raise SarcliError(f"unknown algorithm '{opts.algorithm}' (use {', '.join(ALGORITHMS)})")
-    if opts.near not in ("rd", "bp"):
-        raise SarcliError("the near-range algorithm must be 'rd' or 'bp'")
+    scan, order = ordered(scan)
     pols = pols or scan.polarizations
     lx = scan.antenna.length_azimuth_m
     prof0 = range_compress(scan, pols[0], opts.range_window, 1, opts.max_range_m)
@@ -180,7 +248,8 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
         "used": {k: [float(grid.ranges[v][0]), float(grid.ranges[v][-1])] for k, v in alg_plan.items()},
         "df_min_range_m": split, "criterion_rad": opts.criterion_rad,
         "near_algorithm": opts.near if opts.algorithm == "auto" else None,
-        "rail_uniform": bool(uniform), "skipped_stops": prof0.skipped,
+        "rail_uniform": bool(uniform), "skipped_stops": sorted(int(order[i]) for i in prof0.skipped),
+        "rail_reordered": bool(np.any(order != np.arange(order.size))),
         # L_x of the beam footprint |x - x_i| <= lam R0/(2 L_x) that limits each pixel's aperture
         # (None: whole rail); interferometry masks pixels outside it (sarcli.gbsar.interferometry.support)
         "footprint_antenna_length_m": lx if opts.beam_limited else None,
@@ -204,8 +273,8 @@ def image_from_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | N
     from sarcli.model.gbsar import GbsarImage
 
     opts = opts or FocusOptions()
-    f = focus_scan(scan, opts, grid, pols)
-    fr, x = scan.frequency, scan.rail_position
+    f = focus_scan(scan, opts, grid, pols)  # checked the rail: finite, >= 2 distinct positions
+    fr, x = scan.frequency, np.sort(np.asarray(scan.rail_position, np.float64))
     return GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
                       polarizations=tuple(f.report["polarizations"]), algorithm=opts.algorithm,
                       center_frequency_hz=float(0.5 * (fr[0] + fr[-1])),

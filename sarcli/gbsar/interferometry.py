@@ -37,11 +37,18 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import uniform_filter
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ProductError, SarcliError
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import GbsarImage
 
 MODES = ("dinsar", "crosstrack", "deltaf", "combined")
+
+
+def pol_index(img: GbsarImage, pol: str) -> int:
+    """Index of ``pol`` in the image's first axis (the pixels are not read: ``image`` may be on disk)."""
+    if pol not in img.polarizations:
+        raise ProductError(f"image has polarizations {','.join(img.polarizations)}, not {pol}")
+    return img.polarizations.index(pol)
 
 
 def check_same_grid(a: GbsarImage, b: GbsarImage, pol: str) -> None:
@@ -53,7 +60,7 @@ def check_same_grid(a: GbsarImage, b: GbsarImage, pol: str) -> None:
             not np.allclose(a.range_m, b.range_m, atol=1e-6) or not np.allclose(a.azimuth_m, b.azimuth_m, atol=1e-6):
         raise SarcliError("the images are on different grids; focus both with the same --max-range/--pixel-x/--width")
     for img in (a, b):
-        img.pol(pol)
+        pol_index(img, pol)
 
 
 def check_compatible(a: GbsarImage, b: GbsarImage, mode: str, pol: str) -> None:
@@ -85,20 +92,23 @@ def coherence(a: np.ndarray, b: np.ndarray, window: int) -> np.ndarray:
         return np.where(pa * pb > 0, num / np.sqrt(pa * pb), 0.0).astype(np.float32)
 
 
-def support(img: GbsarImage, pol: str) -> np.ndarray:
-    """(n_r, n_x) bool: pixels the image has data for.
+def support(img: GbsarImage, pol: str, rows: slice = slice(None), values: np.ndarray | None = None) -> np.ndarray:
+    """(n_r, n_x) bool (or the ``rows`` block of it): pixels the image has data for.
 
     Covered by its algorithm (``algorithm_map != 0``), non-zero, and -- when the product records the
     footprint's L_x (``report["footprint_antenna_length_m"]``) -- seen by some rail stop: the pixel's
     synthetic aperture, the rail ``[x_c - X/2, x_c + X/2]`` intersected with the beam footprint
     ``|x - x_i| <= lam R0/(2 L_x)`` (seed 000 Fig. 2, as in BP and DF), is not empty. RD leaks energy
     outside the footprint (non-zero there), so the geometric test is needed beside the zero test.
+    ``values``: the block ``image[pol, rows]`` when the caller has read it already (it is read otherwise).
     """
-    ok = (img.algorithm_map != 0) & (img.pol(pol) != 0)
+    if values is None:
+        values = img.image[pol_index(img, pol), rows]
+    ok = (img.algorithm_map[rows] != 0) & (np.asarray(values) != 0)
     lx = img.report.get("footprint_antenna_length_m")
     if lx:
         off_rail = np.maximum(np.abs(img.azimuth_m - img.rail_centre_m) - img.rail_length_m / 2, 0.0)
-        ok &= off_rail[None, :] <= img.wavelength_m * img.range_m[:, None] / (2 * lx)
+        ok &= off_rail[None, :] <= img.wavelength_m * img.range_m[rows, None] / (2 * lx)
     return ok
 
 

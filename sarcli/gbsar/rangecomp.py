@@ -22,21 +22,9 @@ import scipy.fft
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.system import next_pow2
+from sarcli.gbsar.windows import taper
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import Scan
-
-WINDOWS = ("hamming", "hann", "none")
-
-
-def window(name: str, n: int) -> np.ndarray:
-    """Real taper of length n (``none`` = rectangular)."""
-    if name == "hamming":
-        return np.hamming(n) if n > 1 else np.ones(n)
-    if name == "hann":
-        return np.hanning(n + 2)[1:-1]
-    if name == "none":
-        return np.ones(n)
-    raise SarcliError(f"unknown window '{name}' (use {', '.join(WINDOWS)})")
 
 
 @dataclass
@@ -80,7 +68,8 @@ def check_sweep(frequency: np.ndarray) -> float:
 def range_compress(scan: Scan, pol: str, window_name: str = "hamming", oversample: int = 1,
                    max_range_m: float | None = None) -> RangeProfiles:
     """Range-compress one polarization: N = oversample * 2^ceil(log2 N_R) FFT bins (N_Rfft of Table 1
-    for oversample = 1), ranges up to ``min(max_range_m, R_max)``."""
+    for oversample = 1), ranges up to ``min(max_range_m, R_max)``; ``window_name`` is a taper spec
+    (:mod:`sarcli.gbsar.windows`) over the frequencies."""
     if oversample < 1:
         raise SarcliError("range oversampling must be >= 1")
     df = check_sweep(scan.frequency)
@@ -92,7 +81,7 @@ def range_compress(scan: Scan, pol: str, window_name: str = "hamming", oversampl
     dr = C_LIGHT / (2 * n_fft * df)
     r_top = C_LIGHT / (4 * df) if max_range_m is None else min(float(max_range_m), C_LIGHT / (4 * df))
     n_keep = min(int(np.floor(r_top / dr + 1e-9)) + 1, n_fft // 2 + 1)
-    w = window(window_name, n_r)
+    w = taper(window_name, n_r)
     x = s.astype(np.complex64) * (w / w.sum()).astype(np.float32)[None, :]  # complex64: the data's precision
     x[bad] = 0.0
     p = scipy.fft.ifft(x, n=n_fft, axis=1)[:, :n_keep]
@@ -106,5 +95,5 @@ def range_compress(scan: Scan, pol: str, window_name: str = "hamming", oversampl
 
 
 def stop_weights(prof: RangeProfiles, azimuth_window: str) -> np.ndarray:
-    """Azimuth window over the rail stops times stop validity (float64, n_stops)."""
-    return window(azimuth_window, prof.positions_m.size) * prof.weights
+    """Azimuth taper over the rail stops times stop validity (float64, n_stops)."""
+    return taper(azimuth_window, prof.positions_m.size) * prof.weights

@@ -41,8 +41,9 @@ import scipy.fft
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.deramp import uniform_step
-from sarcli.gbsar.rangecomp import RangeProfiles, window
+from sarcli.gbsar.rangecomp import RangeProfiles
 from sarcli.gbsar.system import next_pow2
+from sarcli.gbsar.windows import taper
 
 
 @dataclass
@@ -103,8 +104,8 @@ def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = 
     u = scipy.fft.fftfreq(n, dx)
     band = np.abs(u) <= 1.0 / antenna_length_m  # the beam's wavenumbers, |sin(theta)| <= lam/(2 L_x)
     w_beam = np.zeros(n)
-    w_beam[np.flatnonzero(band)[np.argsort(u[band])]] = window(azimuth_window, int(band.sum()))
-    w_rail = window(azimuth_window, n_x)
+    w_beam[np.flatnonzero(band)[np.argsort(u[band])]] = taper(azimuth_window, int(band.sum()))
+    w_rail = taper(azimuth_window, n_x)
     sin_t = -lam * u / 2
     cos_t = np.sqrt(np.clip(1.0 - sin_t ** 2, 0.0, None))
     stretch = 1.0 / np.min(cos_t[band]) if band.any() else 1.0

@@ -26,29 +26,28 @@ listed under ``[effects.<name>]`` are computed. Layout (SI units, degrees only w
 
 ``scattering`` is a table ``{VV = a, VH = a, HV = a, HH = a}`` whose values are a real number or a
 ``[re, im]`` pair (missing channels are 0), or a single value/pair meaning VV = HH = value.
+
+Each table is a frozen dataclass below (:class:`SceneFile` and its sections), checked by the one
+configuration helper :func:`sarcli.config.from_mapping`: an unknown key or a value of the wrong type
+is one :class:`~sarcli.errors.ConfigError` line naming the file and the table
+(``scene.toml [rail]: unknown option(s) lenght_m; known: ...``).
 """
 
 from __future__ import annotations
 
 import os
-import tomllib
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 
-from sarcli.errors import ConfigError, FormatError, SarcliError
+from sarcli.config import from_mapping, load_toml
+from sarcli.errors import ConfigError
 from sarcli.io.scan import POLARIZATIONS
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import Antenna, Site
 
-EFFECTS = ("antenna_pattern", "noise", "vertical_baseline", "frequency_shift", "displacement",
-           "decorrelation", "atmosphere")
-_EFFECT_KEYS = {
-    "antenna_pattern": {}, "noise": {"power_db": -60.0}, "vertical_baseline": {"offset_m": 0.0},
-    "frequency_shift": {"shift_hz": 0.0}, "displacement": {"scale": 1.0},
-    "decorrelation": {"coherence": 0.5}, "atmosphere": {"refractivity_ppm": 0.0},
-}
 KIND_POINT, KIND_WALL, KIND_CLUTTER = 0, 1, 2
 
 
@@ -107,29 +106,222 @@ class Scene:
         return self.stop_duration_s * np.arange(self.positions_m.size, dtype=np.float64)
 
 
-class _Table:
-    """A TOML table read key by key; leftover (unknown) keys are refused in one line."""
+@dataclass(frozen=True)
+class SceneSection:
+    """``[scene]``: name, per-acquisition seed (noise, decorrelation), epoch (ISO-8601 UTC)."""
 
-    def __init__(self, d: Any, where: str):
-        if not isinstance(d, dict):
-            raise FormatError(f"scene: [{where}] must be a table")
-        self.d, self.where, self.used = d, where, set()
+    name: str = "gbsar"
+    seed: int = 0
+    epoch_utc: str = "2000-01-01T00:00:00Z"
 
-    def get(self, key: str, default: Any = None, kind: type | tuple = (int, float)) -> Any:
-        self.used.add(key)
-        if key not in self.d:
-            if default is None:
-                raise FormatError(f"scene: [{self.where}] needs '{key}'")
-            return default
-        v = self.d[key]
-        if kind is not None and (not isinstance(v, kind) or isinstance(v, bool) and kind is not bool):
-            raise FormatError(f"scene: [{self.where}] {key} has the wrong type ({type(v).__name__})")
-        return v
 
-    def done(self) -> None:
-        extra = sorted(set(self.d) - self.used)
-        if extra:
-            raise FormatError(f"scene: [{self.where}] unknown key(s) {', '.join(extra)}")
+@dataclass(frozen=True)
+class SweepSection:
+    """``[sweep]``: the VNA sweep (Hz) and the polarizations (TX letter, RX letter)."""
+
+    center_frequency_hz: float
+    points: int
+    bandwidth_hz: float = 0.0
+    polarizations: tuple[str, ...] = ("VV",)
+
+    def __post_init__(self) -> None:
+        fc, bw, n = self.center_frequency_hz, self.bandwidth_hz, self.points
+        if not (fc > 0 and bw >= 0 and n >= 1 and (n == 1 or bw > 0)) or not np.isfinite([fc, bw]).all():
+            raise ConfigError("[sweep] needs center_frequency_hz > 0, points >= 1 and bandwidth_hz > 0")
+        if fc - bw / 2 <= 0:
+            raise ConfigError("[sweep] the sweep would reach zero or negative frequencies")
+        pols = tuple(p.upper() for p in self.polarizations)
+        if not pols or any(p not in POLARIZATIONS for p in pols) or len(set(pols)) != len(pols):
+            raise ConfigError(f"[sweep] polarizations must be distinct names among {POLARIZATIONS}")
+        object.__setattr__(self, "polarizations", pols)
+
+
+@dataclass(frozen=True)
+class RailSection:
+    """``[rail]``: ``length_m`` + ``step_m`` (stops centred on x = 0) or ``positions_m``; antenna height (m)."""
+
+    length_m: float | None = None
+    step_m: float | None = None
+    positions_m: tuple[float, ...] | None = None
+    height_m: float = 0.0
+    stop_duration_s: float = 1.0
+
+    def positions(self) -> np.ndarray:
+        if self.positions_m is not None:
+            pos = np.asarray(self.positions_m, np.float64)
+        else:
+            if self.length_m is None or self.step_m is None:
+                raise ConfigError("[rail] needs length_m and step_m, or positions_m")
+            if not (self.step_m > 0 and self.length_m >= 0):
+                raise ConfigError("[rail] needs step_m > 0 and length_m >= 0")
+            n = int(round(self.length_m / self.step_m)) + 1  # N_x = X/dx + 1 (Table 1 prints "- 1", a typo)
+            pos = (np.arange(n) - (n - 1) / 2) * self.step_m
+        if pos.size < 1 or not np.all(np.isfinite(pos)):
+            raise ConfigError("[rail] positions must be a non-empty list of finite numbers")
+        if pos.size > 1 and not np.all(np.diff(pos) > 0):
+            raise ConfigError("[rail] positions must be strictly increasing")
+        return pos
+
+
+@dataclass(frozen=True)
+class AntennaSection:
+    """``[antenna]``: L_x, L_R (m), gain, depression (deg), pattern (used with the antenna_pattern effect)."""
+
+    length_azimuth_m: float = 0.25
+    length_range_m: float = 0.25
+    gain_dbi: float = 20.0
+    depression_deg: float = 0.0
+    pattern: Literal["sinc", "rect"] = "sinc"
+
+    def __post_init__(self) -> None:
+        if not (self.length_azimuth_m > 0 and self.length_range_m > 0):
+            raise ConfigError("[antenna] needs positive lengths")
+
+
+@dataclass(frozen=True)
+class PointEntry:
+    """``[[points]]``: position (m), scattering, stability, displacement (vector or along the LOS, mm)."""
+
+    y_m: float
+    x_m: float = 0.0
+    z_m: float = 0.0
+    scattering: Any = 1.0
+    stable: bool = True
+    displacement_mm: tuple[float, float, float] | None = None
+    los_displacement_mm: float | None = None
+
+
+@dataclass(frozen=True)
+class WallEntry:
+    """``[[walls]]``: a line of scatterers from ``start_m`` to ``end_m`` every ``spacing_m`` (default lam/4)."""
+
+    start_m: tuple[float, float, float]
+    end_m: tuple[float, float, float]
+    spacing_m: float | None = None
+    scattering: Any = 1.0
+    stable: bool = True
+    displacement_mm: tuple[float, float, float] | None = None
+    los_displacement_mm: float | None = None
+
+
+@dataclass(frozen=True)
+class ClutterSection:
+    """``[clutter]``: a seeded Poisson field of scatterers over ``x_m`` x ``y_m`` (``[min, max]`` pairs)."""
+
+    x_m: tuple[float, float]
+    y_m: tuple[float, float]
+    density_per_m2: float
+    z_m: float = 0.0
+    scattering: Any = 1.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.x_m[1] < self.x_m[0] or self.y_m[1] < self.y_m[0]:
+            raise ConfigError("[clutter] x_m and y_m are [min, max] pairs")
+
+
+@dataclass(frozen=True)
+class AntennaPatternEffect:
+    """Two-way pattern of the L_x x L_R aperture."""
+
+
+@dataclass(frozen=True)
+class NoiseEffect:
+    power_db: float = -60.0  # complex white noise power per S21 sample (dB re 1)
+
+
+@dataclass(frozen=True)
+class VerticalBaselineEffect:
+    offset_m: float = 0.0  # added to every rail height
+
+
+@dataclass(frozen=True)
+class FrequencyShiftEffect:
+    shift_hz: float = 0.0  # added to every sweep frequency
+
+
+@dataclass(frozen=True)
+class DisplacementEffect:
+    scale: float = 1.0  # target displacements applied times scale
+
+
+@dataclass(frozen=True)
+class DecorrelationEffect:
+    coherence: float = 0.5  # of unstable scatterers (clutter and stable = false) between scans
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.coherence <= 1.0:
+            raise ConfigError("[effects.decorrelation] coherence must be in [0, 1]")
+
+
+@dataclass(frozen=True)
+class AtmosphereEffect:
+    refractivity_ppm: float = 0.0  # extra path (N * 1e-6) * R
+
+
+@dataclass(frozen=True)
+class EffectsSection:
+    """``[effects.<name>]``: an effect is computed only when its table is present."""
+
+    antenna_pattern: AntennaPatternEffect | None = None
+    noise: NoiseEffect | None = None
+    vertical_baseline: VerticalBaselineEffect | None = None
+    frequency_shift: FrequencyShiftEffect | None = None
+    displacement: DisplacementEffect | None = None
+    decorrelation: DecorrelationEffect | None = None
+    atmosphere: AtmosphereEffect | None = None
+
+    def as_dict(self) -> dict[str, dict[str, float]]:
+        return {f.name: asdict(v) for f in fields(self) if (v := getattr(self, f.name)) is not None}
+
+
+@dataclass(frozen=True)
+class ProcessingSection:
+    max_range_m: float | None = None  # image extent used by `plan` for N_xfft of RD
+
+
+@dataclass(frozen=True)
+class SceneFile:
+    """A scene TOML document, checked (unknown keys, types) by :func:`sarcli.config.from_mapping`."""
+
+    sweep: SweepSection
+    scene: SceneSection = field(default_factory=SceneSection)
+    rail: RailSection = field(default_factory=RailSection)
+    antenna: AntennaSection = field(default_factory=AntennaSection)
+    site: Site = field(default_factory=Site)
+    processing: ProcessingSection = field(default_factory=ProcessingSection)
+    points: tuple[PointEntry, ...] = ()
+    walls: tuple[WallEntry, ...] = ()
+    clutter: ClutterSection | None = None
+    effects: EffectsSection = field(default_factory=EffectsSection)
+
+
+_TABLES = {"scene": SceneSection, "sweep": SweepSection, "rail": RailSection, "antenna": AntennaSection,
+           "site": Site, "processing": ProcessingSection, "clutter": ClutterSection, "effects": EffectsSection}
+_ARRAYS = {"points": PointEntry, "walls": WallEntry}
+
+
+def parse_scene_file(doc: Any, source: str = "scene") -> SceneFile:
+    """Check a parsed scene TOML: every table through :func:`sarcli.config.from_mapping`; messages name
+    ``source`` (the file) and the table (``scene.toml [rail]: ...``, ``scene.toml [[points]] 2: ...``)."""
+    if not isinstance(doc, dict):
+        raise ConfigError(f"{source}: a scene is a table of sections")
+    parts: dict[str, Any] = {}
+    for key, value in doc.items():
+        try:
+            if key in _TABLES:
+                parts[key] = from_mapping(_TABLES[key], value, f"{source} [{key}]")
+            elif key in _ARRAYS:
+                if not isinstance(value, list):
+                    raise ConfigError(f"{source}: {key} must be an array of tables ([[{key}]])")
+                parts[key] = tuple(from_mapping(_ARRAYS[key], v, f"{source} [[{key}]] {i}")
+                                   for i, v in enumerate(value))
+            else:
+                parts[key] = value
+        except ConfigError as e:  # a __post_init__ check names its table, not the file
+            msg = str(e)
+            raise ConfigError(msg if msg.startswith(source) else f"{source}: {msg}") from None
+    return from_mapping(SceneFile, parts, source)
 
 
 def _complex(v: Any, where: str) -> complex:
@@ -137,7 +329,7 @@ def _complex(v: Any, where: str) -> complex:
         return complex(v)
     if isinstance(v, list) and len(v) == 2 and all(isinstance(a, int | float) for a in v):
         return complex(v[0], v[1])
-    raise FormatError(f"scene: {where}: a reflectivity is a number or an [re, im] pair")
+    raise ConfigError(f"{where}: a reflectivity is a number or an [re, im] pair")
 
 
 def _scattering(v: Any, where: str) -> np.ndarray:
@@ -146,90 +338,53 @@ def _scattering(v: Any, where: str) -> np.ndarray:
     if isinstance(v, dict):
         for k, a in v.items():
             if k.upper() not in POLARIZATIONS:
-                raise FormatError(f"scene: {where}: unknown polarization '{k}' (use VV, VH, HV, HH)")
+                raise ConfigError(f"{where}: unknown polarization '{k}' (use VV, VH, HV, HH)")
             out[POLARIZATIONS.index(k.upper())] = _complex(a, where)
     else:
         out[0] = out[3] = _complex(v, where)
     return out
 
 
-def _vec3(v: Any, where: str) -> np.ndarray:
-    if not (isinstance(v, list) and len(v) == 3 and all(isinstance(a, int | float) for a in v)):
-        raise FormatError(f"scene: {where} must be [x, y, z] in metres")
-    return np.asarray(v, np.float64)
-
-
-def _rail(t: _Table) -> tuple[np.ndarray, float, float]:
-    if "positions_m" in t.d:
-        pos = np.asarray(t.get("positions_m", kind=list), np.float64)
-    else:
-        length, step = float(t.get("length_m")), float(t.get("step_m"))
-        if step <= 0 or length < 0:
-            raise FormatError("scene: [rail] needs step_m > 0 and length_m >= 0")
-        n = int(round(length / step)) + 1  # N_x = X/dx + 1 (Table 1 prints "- 1", a typo)
-        pos = (np.arange(n) - (n - 1) / 2) * step
-    if pos.ndim != 1 or pos.size < 1 or not np.all(np.isfinite(pos)):
-        raise FormatError("scene: [rail] positions must be a non-empty list of finite numbers")
-    if pos.size > 1 and not np.all(np.diff(pos) > 0):
-        raise FormatError("scene: [rail] positions must be strictly increasing")
-    height = float(t.get("height_m", 0.0))
-    dur = float(t.get("stop_duration_s", 1.0))
-    t.done()
-    return pos, height, dur
-
-
-def _targets(doc: dict, lam: float, rail_h: float) -> list[tuple[np.ndarray, np.ndarray, int, bool,
-                                                                  np.ndarray]]:
-    """(positions (k,3), reflectivity (4,k), kind, stable, displacement (3,) m) per points/walls entry."""
-    out = []
-    for i, p in enumerate(doc.get("points", [])):
-        t = _Table(p, f"points {i}")
-        pos = np.array([t.get("x_m", 0.0), t.get("y_m"), t.get("z_m", 0.0)], np.float64)
-        refl = _scattering(t.get("scattering", 1.0, kind=None), f"points {i}")
-        disp = _displacement(t, pos, rail_h, f"points {i}")
-        stable = bool(t.get("stable", True, kind=bool))
-        t.done()
-        out.append((pos[None, :], refl[:, None], KIND_POINT, stable, disp))
-    for i, w in enumerate(doc.get("walls", [])):
-        t = _Table(w, f"walls {i}")
-        a, b = _vec3(t.get("start_m", kind=list), f"walls {i} start_m"), _vec3(t.get("end_m", kind=list),
-                                                                                f"walls {i} end_m")
-        spacing = float(t.get("spacing_m", lam / 4))
-        if spacing <= 0:
-            raise FormatError(f"scene: [walls {i}] spacing_m must be > 0")
-        n = max(int(np.ceil(np.linalg.norm(b - a) / spacing)) + 1, 2)
-        pos = a + (b - a) * np.linspace(0.0, 1.0, n)[:, None]
-        refl = np.repeat(_scattering(t.get("scattering", 1.0, kind=None), f"walls {i}")[:, None], n, 1)
-        disp = _displacement(t, 0.5 * (a + b), rail_h, f"walls {i}")
-        stable = bool(t.get("stable", True, kind=bool))
-        t.done()
-        out.append((pos, refl, KIND_WALL, stable, disp))
-    return out
-
-
-def _displacement(t: _Table, pos: np.ndarray, rail_h: float, where: str) -> np.ndarray:
-    if "displacement_mm" in t.d and "los_displacement_mm" in t.d:
-        raise FormatError(f"scene: [{where}] give displacement_mm or los_displacement_mm, not both")
-    if "displacement_mm" in t.d:
-        return _vec3(t.get("displacement_mm", kind=list), f"{where} displacement_mm") * 1e-3
-    los = float(t.get("los_displacement_mm", 0.0)) * 1e-3
+def _displacement(e: PointEntry | WallEntry, pos: np.ndarray, rail_h: float, where: str) -> np.ndarray:
+    """Displacement (3,) m: the vector, or ``los_displacement_mm`` along the line of sight from the rail centre."""
+    if e.displacement_mm is not None and e.los_displacement_mm is not None:
+        raise ConfigError(f"{where}: give displacement_mm or los_displacement_mm, not both")
+    if e.displacement_mm is not None:
+        return np.asarray(e.displacement_mm, np.float64) * 1e-3
+    los = (e.los_displacement_mm or 0.0) * 1e-3
     r = pos - np.array([0.0, 0.0, rail_h])
     nr = np.linalg.norm(r)
     return r / nr * los if nr > 0 else np.zeros(3)
 
 
-def _clutter(d: Any, rail_h: float) -> tuple[np.ndarray, np.ndarray]:
-    t = _Table(d, "clutter")
-    xr, yr = t.get("x_m", kind=list), t.get("y_m", kind=list)
-    if len(xr) != 2 or len(yr) != 2 or xr[1] < xr[0] or yr[1] < yr[0]:
-        raise FormatError("scene: [clutter] x_m and y_m are [min, max] pairs")
-    z = float(t.get("z_m", 0.0))
-    dens = float(t.get("density_per_m2"))
-    scat = _scattering(t.get("scattering", 1.0, kind=None), "clutter")
-    rng = np.random.default_rng(int(t.get("seed", 0, kind=int)))
-    t.done()
-    n = int(rng.poisson(dens * (xr[1] - xr[0]) * (yr[1] - yr[0])))
-    pos = np.column_stack([rng.uniform(xr[0], xr[1], n), rng.uniform(yr[0], yr[1], n), np.full(n, z)])
+def _targets(doc: SceneFile, lam: float, rail_h: float, source: str
+             ) -> list[tuple[np.ndarray, np.ndarray, int, bool, np.ndarray]]:
+    """(positions (k,3), reflectivity (4,k), kind, stable, displacement (3,) m) per points/walls entry."""
+    out = []
+    for i, p in enumerate(doc.points):
+        where = f"{source} [[points]] {i}"
+        pos = np.array([p.x_m, p.y_m, p.z_m], np.float64)
+        out.append((pos[None, :], _scattering(p.scattering, where)[:, None], KIND_POINT, p.stable,
+                    _displacement(p, pos, rail_h, where)))
+    for i, w in enumerate(doc.walls):
+        where = f"{source} [[walls]] {i}"
+        a, b = np.asarray(w.start_m, np.float64), np.asarray(w.end_m, np.float64)
+        spacing = lam / 4 if w.spacing_m is None else w.spacing_m
+        if not spacing > 0:
+            raise ConfigError(f"{where}: spacing_m must be > 0")
+        n = max(int(np.ceil(np.linalg.norm(b - a) / spacing)) + 1, 2)
+        pos = a + (b - a) * np.linspace(0.0, 1.0, n)[:, None]
+        refl = np.repeat(_scattering(w.scattering, where)[:, None], n, 1)
+        out.append((pos, refl, KIND_WALL, w.stable, _displacement(w, 0.5 * (a + b), rail_h, where)))
+    return out
+
+
+def _clutter(c: ClutterSection, source: str) -> tuple[np.ndarray, np.ndarray]:
+    (x0, x1), (y0, y1) = c.x_m, c.y_m
+    scat = _scattering(c.scattering, f"{source} [clutter]")
+    rng = np.random.default_rng(c.seed)
+    n = int(rng.poisson(c.density_per_m2 * (x1 - x0) * (y1 - y0)))
+    pos = np.column_stack([rng.uniform(x0, x1, n), rng.uniform(y0, y1, n), np.full(n, c.z_m)])
     # co-polar channels share one circular Gaussian, cross-polar channels another (reciprocal VH = HV)
     g = (rng.standard_normal((2, n)) + 1j * rng.standard_normal((2, n))) / np.sqrt(2)
     refl = np.empty((4, n), np.complex128)
@@ -238,75 +393,34 @@ def _clutter(d: Any, rail_h: float) -> tuple[np.ndarray, np.ndarray]:
     return pos, refl
 
 
-def scene_from_dict(doc: dict, source_toml: str = "") -> Scene:
-    """Build a scene from a parsed TOML document (see the module docstring for the layout)."""
-    known = {"scene", "sweep", "rail", "antenna", "site", "processing", "points", "walls", "clutter",
-             "effects"}
-    extra = sorted(set(doc) - known)
-    if extra:
-        raise FormatError(f"scene: unknown section(s) {', '.join(extra)}")
-    sc = _Table(doc.get("scene", {}), "scene")
-    name = str(sc.get("name", "gbsar", kind=str))
-    seed = int(sc.get("seed", 0, kind=int))
-    epoch = str(sc.get("epoch_utc", "2000-01-01T00:00:00Z", kind=str))
-    sc.done()
-
-    sw = _Table(doc.get("sweep", {}), "sweep")
-    fc, bw = float(sw.get("center_frequency_hz")), float(sw.get("bandwidth_hz", 0.0))
-    npts = int(sw.get("points", kind=int))
-    pols = tuple(str(p).upper() for p in sw.get("polarizations", ["VV"], kind=list))
-    sw.done()
-    if fc <= 0 or bw < 0 or npts < 1 or (npts > 1 and bw <= 0):
-        raise FormatError("scene: [sweep] needs center_frequency_hz > 0, points >= 1 and bandwidth_hz > 0")
-    if fc - bw / 2 <= 0:
-        raise FormatError("scene: [sweep] the sweep would reach zero or negative frequencies")
-    if not pols or any(p not in POLARIZATIONS for p in pols) or len(set(pols)) != len(pols):
-        raise FormatError(f"scene: [sweep] polarizations must be distinct names among {POLARIZATIONS}")
-    lam = C_LIGHT / fc
-
-    positions, rail_h, dur = _rail(_Table(doc.get("rail", {}), "rail"))
-
-    an = _Table(doc.get("antenna", {}), "antenna")
-    lx, lr = float(an.get("length_azimuth_m", 0.25)), float(an.get("length_range_m", 0.25))
-    antenna = Antenna(length_azimuth_m=lx, length_range_m=lr, beamwidth_rad=lam / lx,
-                      gain_dbi=float(an.get("gain_dbi", 20.0)))
-    depression = np.deg2rad(float(an.get("depression_deg", 0.0)))
-    pattern = str(an.get("pattern", "sinc", kind=str))
-    an.done()
-    if lx <= 0 or lr <= 0 or pattern not in ("sinc", "rect"):
-        raise FormatError("scene: [antenna] needs positive lengths and pattern 'sinc' or 'rect'")
-
-    si = _Table(doc.get("site", {}), "site")
-    site = Site(latitude_deg=float(si.get("latitude_deg", 0.0)), longitude_deg=float(si.get("longitude_deg", 0.0)),
-                height_m=float(si.get("height_m", 0.0)), heading_deg=float(si.get("heading_deg", 0.0)),
-                look_side=str(si.get("look_side", "right", kind=str)))
-    si.done()
+def scene_from_dict(doc: dict, source_toml: str = "", source: str = "scene") -> Scene:
+    """Build a scene from a parsed TOML document (layout in the module docstring); ``source`` names it
+    in error messages."""
+    f = parse_scene_file(doc, source)
+    sw, rail, an, site = f.sweep, f.rail, f.antenna, f.site
+    lam = C_LIGHT / sw.center_frequency_hz
+    try:
+        positions = rail.positions()
+    except ConfigError as e:
+        raise ConfigError(f"{source}: {e}") from None
     if site.look_side not in ("right", "left") or abs(site.latitude_deg) > 90:
-        raise FormatError("scene: [site] look_side is 'right' or 'left' and |latitude_deg| <= 90")
-
-    effects: dict[str, dict[str, float]] = {}
-    for ename, params in doc.get("effects", {}).items():
-        if ename not in EFFECTS:
-            raise FormatError(f"scene: unknown effect '{ename}' (known: {', '.join(EFFECTS)})")
-        et = _Table(params, f"effects.{ename}")
-        effects[ename] = {k: float(et.get(k, dv)) for k, dv in _EFFECT_KEYS[ename].items()}
-        et.done()
-    if "decorrelation" in effects and not 0.0 <= effects["decorrelation"]["coherence"] <= 1.0:
-        raise FormatError("scene: [effects.decorrelation] coherence must be in [0, 1]")
-
-    scat = _realise(doc, lam, rail_h, seed, effects)
-    pr = _Table(doc.get("processing", {}), "processing")
-    processing = {k: float(pr.get(k)) for k in ("max_range_m",) if k in pr.d}
-    pr.done()
-    return Scene(name=name, seed=seed, epoch_utc=epoch, center_frequency_hz=fc, bandwidth_hz=bw, points=npts,
-                 polarizations=pols, positions_m=positions, height_m=rail_h, stop_duration_s=dur,
-                 antenna=antenna, depression_rad=float(depression), pattern=pattern, site=site,
+        raise ConfigError(f"{source}: [site] look_side is 'right' or 'left' and |latitude_deg| <= 90")
+    antenna = Antenna(length_azimuth_m=an.length_azimuth_m, length_range_m=an.length_range_m,
+                      beamwidth_rad=lam / an.length_azimuth_m, gain_dbi=an.gain_dbi)
+    effects = f.effects.as_dict()
+    scat = _realise(f, lam, rail.height_m, f.scene.seed, effects, source)
+    processing = {} if f.processing.max_range_m is None else {"max_range_m": f.processing.max_range_m}
+    return Scene(name=f.scene.name, seed=f.scene.seed, epoch_utc=f.scene.epoch_utc,
+                 center_frequency_hz=sw.center_frequency_hz, bandwidth_hz=sw.bandwidth_hz, points=sw.points,
+                 polarizations=sw.polarizations, positions_m=positions, height_m=rail.height_m,
+                 stop_duration_s=rail.stop_duration_s, antenna=antenna,
+                 depression_rad=float(np.deg2rad(an.depression_deg)), pattern=an.pattern, site=site,
                  scatterers=scat, effects=effects, processing=processing, source_toml=source_toml)
 
 
-def _realise(doc: dict, lam: float, rail_h: float, seed: int, effects: dict) -> Scatterers:
+def _realise(doc: SceneFile, lam: float, rail_h: float, seed: int, effects: dict, source: str) -> Scatterers:
     """Positions and reflectivities of every scatterer, with displacement and decorrelation applied."""
-    parts = _targets(doc, lam, rail_h)
+    parts = _targets(doc, lam, rail_h, source)
     pos_l, refl_l, kind_l, stable_l, disp_l = [], [], [], [], []
     for pos, refl, kind, stable, disp in parts:
         pos_l.append(pos)
@@ -314,15 +428,15 @@ def _realise(doc: dict, lam: float, rail_h: float, seed: int, effects: dict) -> 
         kind_l.append(np.full(pos.shape[0], kind, np.int8))
         stable_l.append(np.full(pos.shape[0], stable))
         disp_l.append(np.repeat(disp[None, :], pos.shape[0], 0))
-    if "clutter" in doc:
-        cp, cr = _clutter(doc["clutter"], rail_h)
+    if doc.clutter is not None:
+        cp, cr = _clutter(doc.clutter, source)
         pos_l.append(cp)
         refl_l.append(cr)
         kind_l.append(np.full(cp.shape[0], KIND_CLUTTER, np.int8))
         stable_l.append(np.zeros(cp.shape[0], bool))
         disp_l.append(np.zeros((cp.shape[0], 3)))
     if not pos_l:
-        raise FormatError("scene: no scatterers (add [[points]], [[walls]] or [clutter])")
+        raise ConfigError(f"{source}: no scatterers (add [[points]], [[walls]] or [clutter])")
     pos = np.concatenate(pos_l)
     refl = np.concatenate(refl_l, axis=1)
     kind, stable = np.concatenate(kind_l), np.concatenate(stable_l)
@@ -347,16 +461,7 @@ def _realise(doc: dict, lam: float, rail_h: float, seed: int, effects: dict) -> 
 
 
 def load_scene(path: str | os.PathLike) -> Scene:
-    """Read and validate a GB-SAR scene TOML file; errors are one-line :class:`SarcliError`."""
-    try:
-        with open(path, "rb") as f:
-            text = f.read().decode("utf-8")
-    except FileNotFoundError:
-        raise SarcliError(f"{path}: no such scene file") from None
-    except UnicodeDecodeError:
-        raise ConfigError(f"{path}: scene file is not UTF-8 text") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ConfigError(f"{path}: invalid TOML ({e})") from None
-    return scene_from_dict(doc, text)
+    """Read and check a GB-SAR scene TOML file; every error is one :class:`ConfigError` line naming the
+    file and the table."""
+    doc = load_toml(path)
+    return scene_from_dict(doc, Path(path).read_text(encoding="utf-8"), str(path))

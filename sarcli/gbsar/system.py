@@ -156,11 +156,6 @@ def system_from_scene(scene, criterion_rad: float = math.pi / 4) -> System:
                         scene.processing.get("max_range_m"), criterion_rad)
 
 
-def system_from_scan(scan, max_range_m: float | None = None, criterion_rad: float = math.pi / 4) -> System:
-    return build_system(scan.frequency, scan.rail_position, scan.antenna.length_azimuth_m, max_range_m,
-                        criterion_rad)
-
-
 def synthetic_aperture(r0: float, xc: float, rail_length_m: float, wavelength_m: float,
                        antenna_length_m: float) -> tuple[str, float, float]:
     """Region (I-IV) and the synthetic aperture [a, b] of a point at (R0, xc) (eq. 22, 28, 34, 40).

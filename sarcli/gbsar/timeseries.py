@@ -36,10 +36,9 @@ def select_ps(gamma: np.ndarray, mean_amplitude: np.ndarray, threshold: float,
     return np.nonzero((gamma >= threshold) & (mean_amplitude > floor) & (mean_amplitude > 0))
 
 
-def ps_series(stack: np.ndarray, rows: np.ndarray, cols: np.ndarray, wavelength_m: float
-              ) -> tuple[np.ndarray, np.ndarray]:
-    """Phase (rad, unwrapped in time, first = 0) and LOS displacement (mm) of PS pixels: (n_ps, N) each."""
-    z = stack[:, rows, cols].T  # (n_ps, N)
+def ps_series(z: np.ndarray, wavelength_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Phase (rad, unwrapped in time, first = 0) and LOS displacement (mm) of PS pixels whose values
+    in the N images are ``z`` (n_ps, N): (n_ps, N) each."""
     ph = np.unwrap(np.angle(z * np.conj(z[:, :1])), axis=1)
     return ph.astype(np.float32), (-ph * wavelength_m / (4 * np.pi) * 1e3).astype(np.float32)
 

@@ -2,9 +2,13 @@
 
 Layout (SI units)::
 
-    /                 provenance (sarcli.io.h5common; ``parameters`` = every estimation knob),
-                      prf_hz, wavelength_m, summary_json (the scene summary printed by --json),
-                      fdc_method, ambiguity_source, ambiguity_confidence, fr_method, n_az_blocks, n_rg_blocks
+    /                 provenance (sarcli.io.h5common; ``parameters`` = the workflow configuration:
+                      raw, output, plot, options (every estimation knob), height (m)),
+                      prf_hz, wavelength_m, summary_json (the scene summary printed by --json,
+                      :class:`sarcli.model.doppler_summary.DopplerSummary`), fdc_method, ambiguity_source,
+                      ambiguity_confidence, ambiguity_resolved (int 0/1: whether a source decided the
+                      PRF ambiguity; 0 = the centroid's ambiguity is a guess), fr_method, n_az_blocks,
+                      n_rg_blocks
     /blocks           one 1-D dataset per column, one row per (azimuth block, range block), row-major
                       (azimuth outer): range_m, azimuth_time_s, fdc_baseband_hz, quality, weight, valid,
                       ambiguity, margin_prf, fdc_hz (absolute, per block), fdc_fit_hz, fdc_orbit_hz,
@@ -14,7 +18,8 @@ Layout (SI units)::
     /fr_poly          the same for the Doppler rate (Hz/s); an attribute x_power = p (default 0) multiplies
                       it by R^p (map-drift: p = -1, one coefficient -2 Vr^2/lam, fr = -2 Vr^2/(lam R))
 
-``read_doppler(path)`` returns the :class:`sarcli.doppler.model.PolyDoppler` (contract 4).
+``read_doppler(path)`` returns the :class:`sarcli.model.doppler.PolyDoppler` (its summary from
+``summary_json``; older products are read as ``DopplerSummary.from_dict`` describes).
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import numpy as np
 from sarcli.errors import ProductError
 from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, provenance, require, to_jsonable
 from sarcli.model.doppler import PolyDoppler
+from sarcli.model.doppler_summary import DopplerSummary
 from sarcli.model.poly import Poly2D
 
 PRODUCT_TYPE = "doppler"
@@ -53,22 +59,30 @@ def _read_poly(f, name: str, path) -> Poly2D:
     g = f[name]
     coef = require(g, "coef", path, shape_rank=2)[()]
     try:
-        return Poly2D(coef, *(float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys")), int(g.attrs.get("x_power", 0)))
+        x0, xs, y0, ys = (float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys"))
+        return Poly2D(coef, x0, xs, y0, ys, int(g.attrs.get("x_power", 0)))
     except KeyError as e:
         raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
 
 
-def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = ()) -> None:
-    """Write ``model`` atomically to ``path`` (block grid shape from ``model.summary``)."""
-    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, model.parameters, inputs) as f:
+def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = (),
+                  parameters: dict | None = None) -> None:
+    """Write ``model`` atomically to ``path``; ``parameters`` (default ``model.parameters``) is what the
+    product records about how it was made (the workflow passes its configuration)."""
+    s = model.summary
+    if s is None:
+        raise ProductError(f"{path}: a Doppler model without a summary cannot be written as a doppler product")
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, model.parameters if parameters is None else parameters,
+                   inputs) as f:
         f.attrs["prf_hz"] = float(model.prf_hz)
         f.attrs["wavelength_m"] = float(model.wavelength_m)
-        for k in ("n_az_blocks", "n_rg_blocks"):
-            f.attrs[k] = int(model.summary.get(k, 0))
-        f.attrs["summary_json"] = json.dumps(to_jsonable(model.summary), sort_keys=True)
+        f.attrs["n_az_blocks"] = int(s.n_az_blocks)
+        f.attrs["n_rg_blocks"] = int(s.n_rg_blocks)
+        f.attrs["summary_json"] = json.dumps(to_jsonable(s.to_dict()), sort_keys=True)
         for k in ("fdc_method", "ambiguity_source", "fr_method"):
-            f.attrs[k] = str(model.summary.get(k))
-        f.attrs["ambiguity_confidence"] = float(model.summary.get("ambiguity_confidence", 0.0))
+            f.attrs[k] = str(getattr(s, k))
+        f.attrs["ambiguity_confidence"] = float(s.ambiguity_confidence)
+        f.attrs["ambiguity_resolved"] = np.int8(s.ambiguity_resolved)
         g = group(f, "blocks")
         for k in sorted(model.blocks):
             v = np.asarray(model.blocks[k])
@@ -93,7 +107,8 @@ def read_doppler(path: str | os.PathLike) -> PolyDoppler:
                 v = f["blocks"][k][()]
                 blocks[k] = v.astype(bool) if k in ("valid", "outlier") else v
         try:
-            summary = json.loads(attr_str(f, "summary_json") or "{}")
+            summary = DopplerSummary.from_dict(json.loads(attr_str(f, "summary_json") or "{}"),
+                                               f"{path}: summary_json")
         except json.JSONDecodeError:
             raise ProductError(f"{path}: malformed doppler product, summary_json is not JSON") from None
         params = provenance(f).get("parameters") or {}

@@ -15,8 +15,11 @@ Layout (SI units)::
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import json
 import os
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -51,7 +54,10 @@ def write_gbsar_image(path: str | os.PathLike, img: GbsarImage, parameters: dict
             g.attrs[k] = v
 
 
-def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
+@contextlib.contextmanager
+def open_gbsar_image(path: str | os.PathLike) -> Iterator[GbsarImage]:
+    """The image product with its pixels left on disk: ``image`` is the HDF5 dataset (n_pol, n_range,
+    n_azimuth), read by slicing (e.g. a block of rows), valid inside the ``with`` block only."""
     with open_product(path, PRODUCT_TYPE) as f:
         if attr_str(f, "schema_version") != SCHEMA_VERSION:
             raise ProductError(f"{path}: unsupported gbsar_image schema version")
@@ -62,12 +68,18 @@ def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
         site = Site(**{k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
                        for k, v in f["site"].attrs.items()}) if "site" in f else Site()
         img = GbsarImage(
-            image=require(f, "image", path, shape_rank=3, dtype_kind="c")[()],
+            image=require(f, "image", path, shape_rank=3, dtype_kind="c"),
             range_m=require(f, "range", path, shape_rank=1)[()],
             azimuth_m=require(f, "azimuth", path, shape_rank=1)[()],
             algorithm_map=require(f, "algorithm_map", path, shape_rank=2)[()],
             polarizations=tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p),
             site=site, report=json.loads(attr_str(f, "report") or "{}"), **vals)
-    if img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size) or img.image.shape[0] != len(img.polarizations):
-        raise ProductError(f"{path}: malformed gbsar_image, image shape does not match its axes")
-    return img
+        if img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size) or \
+                img.image.shape[0] != len(img.polarizations):
+            raise ProductError(f"{path}: malformed gbsar_image, image shape does not match its axes")
+        yield img
+
+
+def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
+    with open_gbsar_image(path) as img:
+        return dataclasses.replace(img, image=img.image[()])

@@ -23,6 +23,8 @@ Layout (all SI; see ``docs/products.md``)::
       position             float64 (n, 3) m
       velocity             float64 (n, 3) m/s
     /attitude              optional group: time (s), pitch, roll, yaw (rad, float64)
+    /auxiliary             optional group: named arrays a reader keeps beside the echo
+                           (RawProduct.auxiliary; e.g. Sentinel-1 noise/calibration lines)
     /truth                 optional group, simulated products only: scene_toml (attr), targets
                            (compound table), and any truth arrays (e.g. doppler_centroid_hz)
 
@@ -130,6 +132,8 @@ def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = 
         if p.replica is not None:
             dataset(g, "replica", np.asarray(p.replica, np.complex64), units="1")
         write_platform(f, p.orbit, p.attitude)
+        for name, arr in sorted(p.auxiliary.items()):
+            f.create_dataset(f"auxiliary/{name}", data=arr)
         if p.truth is not None:
             write_mapping(f, "truth", p.truth)
 
@@ -219,6 +223,9 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
             replica=g["replica"][()] if "replica" in g else None,
             orbit=orbit, attitude=attitude, truth=truth,
         )
+        if "auxiliary" in f:
+            f["auxiliary"].visititems(
+                lambda name, obj: p.auxiliary.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
         standard = set(PROVENANCE_ATTRS) | {"epoch_utc", "look_side", "source", "n_channels"}
         p.extra_attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()
                          if k not in standard}

@@ -4,6 +4,7 @@
 - :mod:`sarcli.model.raw`: ``Radar``, ``Orbit``, ``Attitude``, ``RawProduct``;
 - :mod:`sarcli.model.slc`: ``SLC``, ``DopplerUsed``;
 - :mod:`sarcli.model.doppler`: the ``DopplerModel`` Protocol, ``PolyDoppler``, ``GeometricDoppler``;
+- :mod:`sarcli.model.doppler_summary`: ``DopplerSummary`` (what a Doppler estimate reports);
 - :mod:`sarcli.model.poly`: ``Poly2D``;
 - :mod:`sarcli.model.gbsar`: ``Site``, ``Antenna``, ``Scan``, ``GbsarImage``.
 

@@ -23,6 +23,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from sarcli.errors import ConfigError
+from sarcli.model.doppler_summary import DopplerSummary
 from sarcli.model.poly import Poly2D
 
 
@@ -45,8 +46,8 @@ class PolyDoppler:
 
     ``blocks`` maps column names to equally long 1-D arrays (one row per (azimuth, range) block):
     range_m, azimuth_time_s, fdc_baseband_hz, quality, weight, valid, ambiguity, margin_prf, fdc_hz,
-    fdc_orbit_hz, fr_hz_per_s, outlier. ``summary`` carries the scene values and the method names
-    (``fdc_method``, ``ambiguity_source`` = orbit|data|none, ``ambiguity_confidence``, ``fr_method``).
+    fdc_orbit_hz, fr_hz_per_s, outlier. ``summary`` (:class:`~sarcli.model.doppler_summary.DopplerSummary`)
+    carries the scene values, the methods and whether the PRF ambiguity was resolved.
     """
 
     fdc_poly: Poly2D
@@ -54,8 +55,14 @@ class PolyDoppler:
     prf_hz: float
     wavelength_m: float
     blocks: dict[str, np.ndarray] = field(default_factory=dict)
-    summary: dict[str, Any] = field(default_factory=dict)
+    summary: DopplerSummary | None = None
     parameters: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def ambiguity_resolved(self) -> bool:
+        """True when a source (orbit, data, user) decided the PRF ambiguity of ``fdc``; False without a
+        summary (nothing says it was)."""
+        return self.summary is not None and self.summary.ambiguity_resolved
 
     def fdc(self, range_m, azimuth_time_s) -> np.ndarray:
         """Absolute Doppler centroid, Hz."""

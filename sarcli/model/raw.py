@@ -73,6 +73,9 @@ class RawProduct:
     attitude: Attitude | None = None
     truth: dict[str, Any] | None = None
     extra_attrs: dict[str, Any] = field(default_factory=dict)
+    #: named arrays a reader keeps beside the echo (e.g. Sentinel-1 noise and calibration lines, packet
+    #: header tables); names may contain '/' (sub-groups); see ``docs/products.md``.
+    auxiliary: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def shape(self) -> tuple[int, int]:

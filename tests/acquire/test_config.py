@@ -76,9 +76,14 @@ def test_travel_beyond_grbl_max_travel(cli, emulator, config_path, tmp_path):
 
 def test_unknown_key_and_section(cli, config_path, tmp_path):
     config_path.write_text(config_path.read_text() + "\n[vna2]\nx = 1\n")
-    assert "unknown configuration section" in one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
+    line = one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
+    assert f"{config_path}: unknown option(s) vna2; known: antenna, polarization, rail, site, vna" in line
     config_path.write_text("[vna]\npoints_typo = 3\n")
-    assert "unknown key 'points_typo'" in one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
+    line = one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
+    assert f"{config_path} [vna]: unknown option(s) points_typo; known: " in line
+    config_path.write_text("[rail]\ncount = 2.5\n")
+    line = one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
+    assert f"{config_path} [rail].count: expected an integer, got 2.5" in line
     config_path.write_text("[vna\n")
     assert "not valid TOML" in one_error(cli("gbsar", "scan", "-c", config_path, "--dry-run"))
 

@@ -22,5 +22,5 @@ def test_demo_scene_centroid_with_agc_undone():
     prf = raw.radar.prf_hz
     truth = np.angle(np.sum(w * np.exp(2j * np.pi * t["doppler_centroid_hz"] / prf))) * prf / (2 * np.pi)
     model = estimate_doppler(raw)
-    base = model.summary["fdc_baseband_hz"]
+    base = model.summary.fdc_baseband_hz
     assert abs(base - truth) < 0.005 * prf

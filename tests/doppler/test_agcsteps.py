@@ -86,15 +86,16 @@ def test_gain_step_modes_in_the_pipeline(clutter_raw):
     import dataclasses
 
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
 
     q = dataclasses.replace(clutter_raw, radar=dataclasses.replace(clutter_raw.radar, quantization_bits=4))
     with_agc = dataclasses.replace(q, agc_db=np.zeros(q.echo.shape[0]))
     kw = dict(az_block=512, rg_block=96)
-    assert estimate_doppler(clutter_raw, **kw).summary["gain_steps"] is None  # not quantized
-    assert estimate_doppler(q, **kw).summary["gain_steps"] == []  # searched, none in this scene
-    assert estimate_doppler(with_agc, **kw).summary["gain_steps"] is None  # the record is used instead
-    assert estimate_doppler(with_agc, gain_steps="on", **kw).summary["gain_steps"] == []
-    assert estimate_doppler(q, gain_steps="off", **kw).summary["gain_steps"] is None
+    assert estimate_doppler(clutter_raw, DopplerOptions(**kw)).summary.gain_steps is None  # not quantized
+    assert estimate_doppler(q, DopplerOptions(**kw)).summary.gain_steps == ()  # searched, none in this scene
+    assert estimate_doppler(with_agc, DopplerOptions(**kw)).summary.gain_steps is None  # the AGC record is used
+    assert estimate_doppler(with_agc, DopplerOptions(gain_steps="on", **kw)).summary.gain_steps == ()
+    assert estimate_doppler(q, DopplerOptions(gain_steps="off", **kw)).summary.gain_steps is None
 
 
 def test_step_statistic_matches_a_least_squares_fit_per_line():

@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from sarcli.doppler.api import estimate_doppler
+from sarcli.doppler.options import DopplerOptions
 from sarcli.io.doppler_product import read_doppler
+from sarcli.io.h5common import to_jsonable
 from sarcli.io.raw import write_raw
 
 JSON_KEYS = {"prf_hz", "fdc_baseband_hz", "ambiguity", "ambiguity_source", "ambiguity_confidence", "fdc_hz",
@@ -35,12 +37,14 @@ def test_cli_json_product_and_plot(cli, raw_file, tmp_path, clutter_raw):
     assert d["fdc_hz"] == pytest.approx(d["fdc_baseband_hz"] + d["ambiguity"] * d["prf_hz"], abs=0.1 * d["prf_hz"])
     assert png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
     m = read_doppler(out)
-    ref = estimate_doppler(clutter_raw, az_block=512, rg_block=96)
+    ref = estimate_doppler(clutter_raw, DopplerOptions(az_block=512, rg_block=96))
     rho = clutter_raw.slant_range()
     t = np.linspace(clutter_raw.azimuth_time[0], clutter_raw.azimuth_time[-1], rho.size)
     np.testing.assert_allclose(m.fdc(rho, t), ref.fdc(rho, t), rtol=0, atol=1e-9)
     np.testing.assert_allclose(m.fr(rho, t), ref.fr(rho, t), rtol=1e-14)
-    assert m.summary["ambiguity"] == d["ambiguity"] and m.parameters["az_block"] == 512
+    assert m.summary.ambiguity == d["ambiguity"] and m.parameters["options"]["az_block"] == 512
+    assert m.ambiguity_resolved and m.parameters["height"] == 0.0
+    assert to_jsonable(m.summary.to_dict()) == {k: v for k, v in d.items() if k not in ("output", "warnings", "blocks")}
     np.testing.assert_array_equal(m.blocks["ambiguity"], [b["ambiguity"] for b in d["blocks"]])
     assert m.blocks["valid"].dtype == bool
     h = cli("doppler", "--help")
@@ -63,7 +67,7 @@ def test_cli_bad_inputs_one_line_errors(cli, tmp_path, clutter_raw, raw_file):
     r = cli("doppler", p)
     assert r.exit_code != 0 and "NaN" in r.stderr and "Traceback" not in r.stderr
     r = cli("doppler", raw_file, "--estimator", "bogus")
-    assert r.exit_code != 0 and "unknown estimator" in r.stderr
+    assert r.exit_code == 2 and "unknown Doppler centroid estimator 'bogus'" in r.stderr
     r = cli("doppler", raw_file, "--fit-degree", "x")
     assert r.exit_code != 0 and "--fit-degree" in r.stderr
     zero = tmp_path / "zero.h5"
@@ -90,7 +94,7 @@ def test_cli_on_the_real_vancouver_block(cli, shared_data, tmp_path):
     assert r.exit_code == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["fdc_baseband_hz"] == pytest.approx(487.0, abs=5.0)
-    assert d["ambiguity"] == -6 and d["ambiguity_source"] == "data"
+    assert d["ambiguity"] == -6 and d["ambiguity_source"] == "data" and d["ambiguity_resolved"] is True
     assert 0.3 < d["ambiguity_confidence"] < 0.9  # MLBF and MLCC disagree: not a certainty
     assert d["fr_method"] == "mapdrift"
     lam = 2.9979e8 / 5.3e9

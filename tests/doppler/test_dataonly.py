@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -31,7 +33,7 @@ def test_combination_rule_is_conservative():
     b = DataOnlyEstimate("mlbf", -7600.0, 100.0, -7, 0.6, np.zeros(1))
     n, conf, _ = combine_estimates([a, b])
     assert n == -6 and conf == pytest.approx(0.9 * 0.4)
-    b.ambiguity = -6
+    b = dataclasses.replace(b, ambiguity=-6)
     assert combine_estimates([a, b])[1] == pytest.approx(0.9)
     assert combine_estimates([])[1] == 0.0
 

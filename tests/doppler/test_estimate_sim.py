@@ -10,6 +10,7 @@ import pytest
 
 from sarcli.doppler.api import estimate_doppler
 from sarcli.doppler.cde import wrap_frequency
+from sarcli.doppler.options import DopplerOptions
 from sarcli.errors import SarcliError
 from sarcli.model.raw import Attitude
 from tests.doppler.conftest import scene_text, simulate_text
@@ -45,13 +46,13 @@ def test_accuracy_bars_on_clutter_scene(big_raw, estimator):
     narrow 384-sample swath it measured 0.58 %.)"""
     raw = big_raw
     tf, tr, rho = _truth(raw)
-    m = estimate_doppler(raw, estimator=estimator)
+    m = estimate_doppler(raw, DopplerOptions(estimator=estimator))
     err = m.fdc(rho, 0.0) - tf
     assert np.sqrt(np.mean(err**2)) < 0.005 * raw.radar.prf_hz
     assert np.max(np.abs(m.fr(rho, 0.0) / tr - 1.0)) < 5e-4
     n_true, _ = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)
-    assert m.summary["ambiguity_source"] == "orbit" and m.summary["ambiguity_confidence"] > 0.99
+    assert m.summary.ambiguity_source == "orbit" and m.summary.ambiguity_confidence > 0.99
 
 
 @pytest.mark.slow
@@ -63,14 +64,14 @@ def test_data_only_route_without_orbit(big_raw):
     tf, tr, rho = _truth(raw)
     m = estimate_doppler(raw)
     s = m.summary
-    assert s["ambiguity_source"] == "data" and s["fr_method"] == "mapdrift"
+    assert s.ambiguity_source == "data" and s.fr_method == "mapdrift" and s.ambiguity_resolved
     n_true, _ = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)
-    assert s["ambiguity_confidence"] > 0.5
-    mlbf = next(e for e in s["data_only"] if e["method"] == "mlbf")
-    assert abs(mlbf["fdc_hz"] - np.mean(tf)) < 3 * mlbf["sigma_hz"] + 0.05 * raw.radar.prf_hz
-    m2 = estimate_doppler(raw, ambiguity_value=int(n_true[0]))
-    assert m2.summary["ambiguity_source"] == "user"
+    assert s.ambiguity_confidence > 0.5
+    mlbf = next(e for e in s.data_only if e.method == "mlbf")
+    assert abs(mlbf.fdc_hz - np.mean(tf)) < 3 * mlbf.sigma_hz + 0.05 * raw.radar.prf_hz
+    m2 = estimate_doppler(raw, DopplerOptions(ambiguity_value=int(n_true[0])))
+    assert m2.summary.ambiguity_source == "user"
     np.testing.assert_array_equal(m2.blocks["ambiguity"], n_true)
     assert np.max(np.abs(m2.fr(rho, 0.0) / tr - 1.0)) < 1e-3
     assert np.sqrt(np.mean((m2.fdc(rho, 0.0) - tf) ** 2)) < 0.01 * raw.radar.prf_hz
@@ -84,22 +85,22 @@ GRID = [(0.0, 0.0), (0.03, 0.004), (-0.03, -0.004), (0.3, -0.05), (-1.4, 0.0), (
 @pytest.mark.parametrize("pitch,yaw", GRID)
 def test_ambiguity_right_over_attitude_grid(pitch, yaw):
     raw = simulate_text(scene_text(pitch_deg=pitch, yaw_deg=yaw))
-    m = estimate_doppler(raw, az_block=512, rg_block=96)
+    m = estimate_doppler(raw, DopplerOptions(az_block=512, rg_block=96))
     n_true, f_true = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)
     assert np.max(np.abs(m.blocks["fdc_hz"] - f_true)) < 0.05 * raw.radar.prf_hz
     # attitude KNOWLEDGE off by the Radarsat-1 limit (0.03 deg pitch, ~140 Hz): still right, with margin
     a = raw.attitude
     wrong = dataclasses.replace(raw, attitude=Attitude(a.time, a.pitch + np.radians(0.03), a.roll, a.yaw))
-    m2 = estimate_doppler(wrong, az_block=512, rg_block=96)
+    m2 = estimate_doppler(wrong, DopplerOptions(az_block=512, rg_block=96))
     np.testing.assert_array_equal(m2.blocks["ambiguity"], n_true)
-    assert 0.2 < m2.summary["ambiguity_margin_prf"] < 0.5
+    assert 0.2 < m2.summary.ambiguity_margin_prf < 0.5
 
 
 def test_ambiguity_ten():
     raw = simulate_text(scene_text(pitch_deg=-1.4))
-    m = estimate_doppler(raw, az_block=512, rg_block=96)
-    assert m.summary["ambiguity"] == -10
+    m = estimate_doppler(raw, DopplerOptions(az_block=512, rg_block=96))
+    assert m.summary.ambiguity == -10
 
 
 def test_scene_within_three_percent_of_an_ambiguity_boundary_does_not_flip():
@@ -111,33 +112,33 @@ def test_scene_within_three_percent_of_an_ambiguity_boundary_does_not_flip():
     dist = 0.5 * prf - np.abs(wrap_frequency(tf, prf))
     assert np.all(dist < 0.03 * prf)
     assert np.any(wrap_frequency(tf, prf) > 0) and np.any(wrap_frequency(tf, prf) < 0)  # straddles the wrap
-    m = estimate_doppler(raw, az_block=256, rg_block=48)
+    m = estimate_doppler(raw, DopplerOptions(az_block=256, rg_block=48))
     n_true, f_true = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)
     absolute = m.blocks["fdc_hz"]
     assert np.max(np.abs(absolute - f_true)) < 0.05 * prf  # continuous, no +-PRF jumps
-    assert 0.0 <= m.summary["ambiguity_margin_prf"] <= 0.5
+    assert 0.0 <= m.summary.ambiguity_margin_prf <= 0.5
 
 
 def test_half_integer_orbit_prediction_is_broken_by_the_data():
     """Attitude knowledge wrong by exactly half a PRF of centroid: the orbit route declares the
     half-integer case and the data-only estimate decides."""
     raw = simulate_text(scene_text())
-    m0 = estimate_doppler(raw, az_block=512, rg_block=96)
+    m0 = estimate_doppler(raw, DopplerOptions(az_block=512, rg_block=96))
     prf = raw.radar.prf_hz
     x = (m0.blocks["fdc_orbit_hz"].mean() - m0.blocks["fdc_hz"].mean()) / prf  # current offset (PRF units)
     # pitch sensitivity from the model itself is NOT used for the expectation: only to build the input
     a = raw.attitude
     dp = np.radians(0.01)
     m1 = estimate_doppler(dataclasses.replace(raw, attitude=Attitude(a.time, a.pitch + dp, a.roll, a.yaw)),
-                          az_block=512, rg_block=96)
+                          DopplerOptions(az_block=512, rg_block=96))
     slope = (m1.blocks["fdc_orbit_hz"].mean() - m0.blocks["fdc_orbit_hz"].mean()) / dp
     shift = (0.5 - x) * prf / slope
     half = dataclasses.replace(raw, attitude=Attitude(a.time, a.pitch + shift, a.roll, a.yaw))
-    m = estimate_doppler(half, az_block=512, rg_block=96)
-    assert m.summary["ambiguity_margin_prf"] < 0.02
-    assert m.summary["ambiguity_source"] == "orbit+data"
-    assert m.summary["ambiguity"] == m0.summary["ambiguity"]
+    m = estimate_doppler(half, DopplerOptions(az_block=512, rg_block=96))
+    assert m.summary.ambiguity_margin_prf < 0.02
+    assert m.summary.ambiguity_source == "orbit+data" and m.ambiguity_resolved  # the data decided
+    assert m.summary.ambiguity == m0.summary.ambiguity
 
 
 def test_hard_inputs_give_clear_errors():
@@ -152,8 +153,8 @@ def test_hard_inputs_give_clear_errors():
     bad[10, 20] = np.inf
     with pytest.raises(SarcliError, match="NaN/inf"):
         estimate_doppler(dataclasses.replace(raw, echo=bad))
-    with pytest.raises(SarcliError, match="unknown estimator"):
-        estimate_doppler(raw, estimator="fft")
+    with pytest.raises(SarcliError, match="unknown Doppler centroid estimator 'fft'; known: cde, lb, rc-cde, sde"):
+        DopplerOptions(estimator="fft")
     one = dataclasses.replace(raw, echo=raw.echo[:1], azimuth_time=raw.azimuth_time[:1])
     with pytest.raises(SarcliError, match="at least 2"):
         estimate_doppler(one)
@@ -167,11 +168,11 @@ def test_noise_blocks_are_not_used():
     rng = np.random.default_rng(0)
     p = np.sqrt(np.mean(np.abs(e) ** 2) / 2)
     e[:, 192:] = (p * (rng.standard_normal((e.shape[0], 192)) + 1j * rng.standard_normal((e.shape[0], 192))))
-    m = estimate_doppler(dataclasses.replace(raw, echo=e), az_block=512, rg_block=96)
+    m = estimate_doppler(dataclasses.replace(raw, echo=e), DopplerOptions(az_block=512, rg_block=96))
     v = m.blocks["valid"].reshape(1, -1)[0]
     assert v[:2].all() and not v[2:].any()
     tf, _, rho = _truth(raw)
-    assert abs(m.summary["fdc_hz"] - np.interp(m.summary["scene_range_m"], rho, tf)) < 0.02 * raw.radar.prf_hz
+    assert abs(m.summary.fdc_hz - np.interp(m.summary.scene_range_m, rho, tf)) < 0.02 * raw.radar.prf_hz
 
 
 def test_very_short_scene_and_saturated_4bit():
@@ -181,7 +182,7 @@ def test_very_short_scene_and_saturated_4bit():
     assert np.mean(np.abs(raw.echo.real) == 15) > 0.3  # saturated
     short = dataclasses.replace(raw, echo=raw.echo[:200], azimuth_time=raw.azimuth_time[:200], agc_db=raw.agc_db[:200])
     m = estimate_doppler(short)
-    assert m.summary["n_az_blocks"] == 1
+    assert m.summary.n_az_blocks == 1
     tf, _, rho = _truth(raw)
     n_true, f_true = _true_block_ambiguity(raw, m)
     np.testing.assert_array_equal(m.blocks["ambiguity"], n_true)

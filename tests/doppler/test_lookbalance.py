@@ -9,6 +9,7 @@ import pytest
 from sarcli.doppler.api import estimate_doppler
 from sarcli.doppler.cde import block_correlation, combine, wrap_frequency
 from sarcli.doppler.lookbalance import look_balance
+from sarcli.doppler.options import DopplerOptions
 from sarcli.errors import SarcliError
 from tests.doppler.conftest import SCENES, simulate_text
 
@@ -78,7 +79,7 @@ def test_blocks_too_close_to_the_scene_ends_are_invalid_and_lb_refuses_short_sce
     _, lb = _blocks(x[:400], 400)
     assert not lb.valid().any()
     with pytest.raises(SarcliError, match="look balance"):
-        estimate_doppler(clutter_raw, estimator="lb")  # 512 lines: nothing 306 lines from both ends
+        estimate_doppler(clutter_raw, DopplerOptions(estimator="lb"))  # 512 lines: nothing 306 lines from both ends
 
 
 @pytest.mark.parametrize("seed", [1, 3, 9])
@@ -99,18 +100,18 @@ def test_coastal_scene_512_line_blocks_against_the_truth():
     raw = simulate_text((SCENES / "rs1_coast.toml").read_text())
     prf, rho = raw.radar.prf_hz, raw.slant_range()
     tf = raw.truth["doppler_centroid_hz"]
-    cde = estimate_doppler(raw, estimator="cde", az_block=512, rg_block=128)
-    lb = estimate_doppler(raw, estimator="lb", az_block=512, rg_block=128)
+    cde = estimate_doppler(raw, DopplerOptions(estimator="cde", az_block=512, rg_block=128))
+    lb = estimate_doppler(raw, DopplerOptions(estimator="lb", az_block=512, rg_block=128))
     b_cde, b_lb = cde.blocks, lb.blocks
     err_cde = b_cde["fdc_hz"] - np.interp(b_cde["range_m"], rho, tf)
     assert np.max(np.abs(err_cde)) > 150.0
     ok = b_lb["valid"]
     err = b_lb["fdc_hz"][ok] - np.interp(b_lb["range_m"][ok], rho, tf)
-    sig = np.array(lb.summary["look_balance"]["sigma_hz"]).ravel()[ok]
+    sig = np.array(lb.summary.estimator_info["sigma_hz"]).ravel()[ok]
     assert ok.sum() >= 5 and np.all(np.abs(err) < 4 * sig + 5.0)
     rms = lambda m: float(np.sqrt(np.mean((m.fdc(rho, 0.0) - tf) ** 2)))  # noqa: E731
     assert rms(cde) > 0.01 * prf and rms(lb) < 0.005 * prf
-    assert lb.summary["fdc_method"] == "lb" and lb.summary["look_balance"]["band_fraction"] == 0.6
+    assert lb.summary.fdc_method == "lb" and lb.summary.estimator_info["band_fraction"] == 0.6
     # edge blocks are placed at the centre of the pixels they used (margin 307 lines at each end)
     t = raw.azimuth_time
     assert b_lb["azimuth_time_s"][0] == pytest.approx(np.interp(0.5 * (307 + 511), np.arange(t.size), t))
@@ -128,8 +129,8 @@ def test_cli_look_balance_matches_the_library(cli, tmp_path):
     import json
 
     d = json.loads(r.stdout)
-    ref = estimate_doppler(raw, estimator="lb", az_block=512, rg_block=128)
-    assert d["fdc_method"] == "lb" and d["fdc_hz"] == pytest.approx(ref.summary["fdc_hz"], abs=1e-6)
+    ref = estimate_doppler(raw, DopplerOptions(estimator="lb", az_block=512, rg_block=128))
+    assert d["fdc_method"] == "lb" and d["fdc_hz"] == pytest.approx(ref.summary.fdc_hz, abs=1e-6)
     bad = cli("doppler", path, "--estimator", "lb", "--lb-band", "0.95")
     assert bad.exit_code != 0 and bad.stderr.count("\n") == 1 and "band fraction" in bad.stderr
     short = cli("doppler", path, "--estimator", "lb", "--az-block", "16")

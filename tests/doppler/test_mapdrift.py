@@ -10,6 +10,7 @@ import pytest
 
 from sarcli.doppler.api import estimate_doppler
 from sarcli.doppler.mapdrift import map_drift
+from sarcli.doppler.options import DopplerOptions
 from sarcli.doppler.rangecomp import range_compress_valid
 from sarcli.errors import SarcliError
 from sarcli.io.doppler_product import read_doppler, write_doppler
@@ -63,15 +64,17 @@ def test_mapdrift_rate_follows_inverse_range_over_the_swath(airborne_raw, tmp_pa
     rho, lam, v = raw.slant_range(), raw.radar.wavelength_m, 2000.0
     tr = raw.truth["doppler_rate_hz_per_s"]
     np.testing.assert_allclose(tr, -2 * v**2 / (lam * rho), rtol=1e-12)  # the scene is what it says
-    m = estimate_doppler(raw, velocity_guess_mps=2200.0, ambiguity_value=0)
-    assert m.summary["fr_method"] == "mapdrift"
+    m = estimate_doppler(raw, DopplerOptions(velocity_guess_mps=2200.0, ambiguity_value=0))
+    assert m.summary.fr_method == "mapdrift"
     assert np.max(np.abs(m.fr(rho, 0.0) / tr - 1.0)) < 1e-3
     far = np.linspace(0.5 * rho[0], 2.0 * rho[-1], 50)
     assert np.max(np.abs(m.fr(far, 0.3) / (-2 * v**2 / (lam * far)) - 1.0)) < 1e-3
-    md = m.summary["fr_info"]["mapdrift"]
-    assert md["n_segments_used"] == 4
-    assert md["velocity_mps"] == pytest.approx(v, rel=5e-4)
-    assert 0 < md["velocity_sigma_mps"] < 5e-4 * v
-    assert abs(md["velocity_mps"] - v) < 4 * md["velocity_sigma_mps"]
+    md = m.summary.fr_info.mapdrift
+    assert md.n_segments_used == 4
+    assert md.velocity_mps == pytest.approx(v, rel=5e-4)
+    assert 0 < md.velocity_sigma_mps < 5e-4 * v
+    assert abs(md.velocity_mps - v) < 4 * md.velocity_sigma_mps
     write_doppler(tmp_path / "d.h5", m)
-    np.testing.assert_allclose(read_doppler(tmp_path / "d.h5").fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
+    back = read_doppler(tmp_path / "d.h5")
+    np.testing.assert_allclose(back.fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
+    assert back.summary.fr_info.mapdrift == md and back.summary == m.summary  # typed summary round trip

@@ -23,18 +23,18 @@ def scan(tmp_path_factory):
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["--max-range", "-3"], "--max-range must be a positive"),
-    (["--max-range", "0"], "--max-range must be a positive"),
-    (["--max-range", "nan"], "--max-range must be a positive"),
+    (["--max-range", "-3"], "max_range_m (--max-range) must be a positive"),
+    (["--max-range", "0"], "max_range_m (--max-range) must be a positive"),
+    (["--max-range", "nan"], "max_range_m (--max-range) must be a positive"),
     # 200 MHz, 201 points: range bins of c / (2 * 256 * 1 MHz) = 0.5855 m; 0.1 m holds one bin (rd crashed)
     (["--algorithm", "rd", "--max-range", "0.1"], "fewer than 4 range bins of 0.586 m"),
     (["--max-range", "2.0"], "fewer than 4 range bins"),
     (["--min-range", "10", "--max-range", "11"], "fewer than 4 range bins"),
-    (["--min-range", "-1"], "--min-range"),
+    (["--min-range", "-1"], "min_range_m (--min-range) must be a finite range >= 0"),
     (["--min-range", "100"], "below the unambiguous range R_max = 74.95 m"),  # c / (4 * 1 MHz)
-    (["--width", "0"], "--width must be a positive"),
+    (["--width", "0"], "width_m (--width) must be a positive"),
     (["--width", "0.01"], "holds no azimuth pixel of 0.3 m"),  # pixel round(0.5855/2 / 0.05) = 6 steps
-    (["--n-xfft", "0"], "--n-xfft must be a positive"),
+    (["--n-xfft", "0"], "n_xfft (--n-xfft) must be a positive"),
     (["--criterion-deg", "400"], "--criterion-deg must be in (0, 180]"),
     (["--criterion-deg", "0"], "--criterion-deg must be in (0, 180]"),
 ])

@@ -120,7 +120,7 @@ def test_ps_coherence_stable_vs_decorrelated():
     gamma = temporal_coherence(stack)
     cols = [int(np.argmin(abs(grid.azimuths - x))) for x in (-6.0, 0.0, 6.0)]
     assert np.all(gamma[0, cols] > 0.99)
-    phase, disp = ps_series(stack, np.zeros(3, int), np.array(cols), 299792458.0 / 5.3e9)
+    phase, disp = ps_series(stack[:, np.zeros(3, int), np.array(cols)].T, 299792458.0 / 5.3e9)
     assert np.max(np.abs(np.degrees(phase))) < 1.0
     assert np.median(gamma[1:]) < 0.9  # decorrelating clutter
     rows, cs = select_ps(gamma, np.mean(np.abs(stack), axis=0), 0.99)

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ConfigError, SarcliError
 from sarcli.gbsar.scene import load_scene, scene_from_dict
 from sarcli.gbsar.simulate import (
     antenna_gain,
@@ -136,8 +136,12 @@ def test_wall_is_a_line_of_scatterers():
 @pytest.mark.parametrize("bad, msg", [
     ({"sweep": {"center_frequency_hz": 5e9, "points": 10}}, "bandwidth"),
     ({"rail": {"positions_m": [0.0, 0.1, 0.05]}}, "increasing"),
-    ({"effects": {"rain": {}}}, "unknown effect"),
-    ({"points": [{"y_m": 5.0, "colour": 1}]}, "unknown key"),
+    ({"effects": {"rain": {}}}, r"scene \[effects\]: unknown option\(s\) rain; known: antenna_pattern"),
+    ({"points": [{"y_m": 5.0, "colour": 1}]}, r"scene \[\[points\]\] 0: unknown option\(s\) colour"),
+    ({"sweep": {"center_frequency_hz": 5e9, "points": 2.5, "bandwidth_hz": 1e6}},
+     r"\[sweep\].points: expected an integer"),
+    ({"effects": {"noise": {"power_db": "loud"}}}, r"\[effects\].noise.power_db: expected a number"),
+    ({"effects": {"decorrelation": {"coherence": 2.0}}}, r"scene: \[effects.decorrelation\] coherence must be in"),
     ({"points": [{"y_m": 5.0, "scattering": {"XX": 1}}]}, "polarization"),
     ({"points": []}, "no scatterers"),
 ])
@@ -153,8 +157,11 @@ def test_samples_load():
 
 
 def test_missing_scene_file(tmp_path):
-    with pytest.raises(SarcliError, match="no such scene"):
+    with pytest.raises(ConfigError, match="nope.toml: no such file"):
         load_scene(tmp_path / "nope.toml")
     (tmp_path / "bad.toml").write_text("[scene\n")
-    with pytest.raises(SarcliError, match="invalid TOML"):
+    with pytest.raises(ConfigError, match="not valid TOML"):
         load_scene(tmp_path / "bad.toml")
+    (tmp_path / "typo.toml").write_text("[sweep]\ncenter_frequency_hz = 5e9\npoints = 1\n[rail]\nlenght_m = 1\n")
+    with pytest.raises(ConfigError, match=r"typo.toml \[rail\]: unknown option\(s\) lenght_m; known: height_m"):
+        load_scene(tmp_path / "typo.toml")

@@ -1,4 +1,7 @@
-"""``sarcli doppler``: Doppler centroid (with ambiguity) and Doppler rate of a raw product -> doppler.h5."""
+"""``sarcli doppler``: Doppler centroid (with ambiguity) and Doppler rate of a raw product -> doppler.h5.
+
+Parses the options into a :class:`sarcli.workflows.doppler.Config`, runs the workflow, prints the report.
+"""
 
 from __future__ import annotations
 
@@ -6,20 +9,15 @@ from pathlib import Path
 
 import typer
 
-from sarcli.cli.common import emit_json, info, progress_bar
-from sarcli.errors import SarcliError
-
-JSON_BLOCK_KEYS = ("range_m", "azimuth_time_s", "fdc_baseband_hz", "quality", "ambiguity", "fdc_hz", "fr_hz_per_s",
-                   "valid", "outlier", "margin_prf")
+from sarcli.cli.common import emit_json, info, progress_bar, require_output_folders
+from sarcli.errors import ConfigError
 
 
 def _degrees(text: str, name: str) -> tuple[int, int]:
     try:
         a, b = (int(v) for v in text.split(","))
     except ValueError:
-        raise SarcliError(f"{name} must be 'RANGE,AZIMUTH' degrees, e.g. 2,1; got {text!r}") from None
-    if not (0 <= a <= 6 and 0 <= b <= 6):
-        raise SarcliError(f"{name} degrees must be in 0..6, got {text!r}")
+        raise ConfigError(f"{name} must be 'RANGE,AZIMUTH' degrees, e.g. 2,1; got {text!r}") from None
     return a, b
 
 
@@ -28,9 +26,12 @@ def doppler(
     output: Path = typer.Option(None, "-o", "--output", help="Doppler product to write (default: none)."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary and the block table as JSON."),
     plot: Path = typer.Option(None, "--plot", help="PNG of fdc and fr against range and azimuth."),
+    height: float = typer.Option(0.0, "--height", help="Terrain height under the scene, metres above the WGS-84 "
+                                 "ellipsoid (for the geometric model; stored in the product)."),
     estimator: str = typer.Option("cde", "--estimator",
                                   help="cde | sde | rc-cde (CDE after range compression) | lb (look balance on "
-                                       "the focused scene: robust to scene contrast, needs > 2 look apertures)."),
+                                       "the focused scene: robust to scene contrast, needs > 2 look apertures) | "
+                                       "a registered plug-in."),
     gain_steps: str = typer.Option("auto", "--gain-steps",
                                    help="Receiver-gain steps recovered from the echo and undone: auto (quantized "
                                         "products without AGC records) | on | off."),
@@ -53,49 +54,36 @@ def doppler(
     The baseband centroid comes from the echoes (CDE per block, seed 2048 x 128); the PRF ambiguity
     from the orbit + attitude model when the product has state vectors, else from the data (MLCC +
     MLBF, with a confidence); the Doppler rate exactly from the orbit, or by map-drift autofocus.
+    An ambiguity nothing could decide is reported (ambiguity_resolved false) with a warning.
 
     Examples:
 
       sarcli doppler raw.h5 -o doppler.h5
 
-      sarcli doppler raw.h5 --json --plot doppler.png
+      sarcli doppler raw.h5 --json --plot doppler.png --height 350
 
       sarcli doppler vancouver.h5 --ambiguity data --az-block 1536 --json
 
       sarcli doppler vancouver.h5 --estimator lb --az-block 512
     """
-    from sarcli.doppler.api import estimate_doppler
-    from sarcli.io.doppler_product import write_doppler
-    from sarcli.io.raw import read_raw
+    from sarcli.config import from_mapping
+    from sarcli.workflows.doppler import Config, run
 
-    degrees = _degrees(fit_degree, "--fit-degree")
-    raw = read_raw(raw_path)
+    options = {"estimator": estimator, "gain_steps": gain_steps, "lb_band_fraction": lb_band, "az_block": az_block,
+               "rg_block": rg_block, "ambiguity": ambiguity, "ambiguity_value": ambiguity_value,
+               "fr_method": fr_method, "fdc_model": fdc_model, "fit_degree": _degrees(fit_degree, "--fit-degree"),
+               "n_nodes": n_nodes, "exact_attitude": not small_angle}
+    config = from_mapping(Config, {"raw": raw_path, "output": output, "plot": plot, "height": height,
+                                   "options": options}, "sarcli doppler")
+    require_output_folders(output, plot)
     with progress_bar(5, label="doppler") as bar:
-        model = estimate_doppler(raw, az_block=az_block, rg_block=rg_block, estimator=estimator,
-                                 ambiguity=ambiguity, ambiguity_value=ambiguity_value, fr_method=fr_method,
-                                 fdc_model=fdc_model, fit_degree=degrees, n_nodes=n_nodes,
-                                 exact_attitude=not small_angle, gain_steps=gain_steps, lb_band_fraction=lb_band,
-                                 progress=lambda _stage: bar.update(1))
-    if output is not None:
-        write_doppler(output, model, inputs=(raw_path,))
-    if plot is not None:
-        from sarcli.doppler.plot import plot_doppler
-
-        plot_doppler(plot, model)
-    s = model.summary
-    info(f"fdc {s['fdc_hz']:.2f} Hz = baseband {s['fdc_baseband_hz']:.2f} Hz + ({s['ambiguity']}) x PRF "
-         f"[{s['ambiguity_source']}, confidence {s['ambiguity_confidence']:.3f}, margin "
-         f"{s['ambiguity_margin_prf']:.3f} PRF]; fr {s['fr_hz_per_s']:.3f} Hz/s [{s['fr_method']}]; "
-         f"{s['n_valid_blocks']}/{s['n_blocks']} blocks valid, {s['n_outlier_blocks']} flagged", quiet or as_json)
-    if s.get("gain_steps"):
-        info(f"undid {len(s['gain_steps'])} receiver-gain step(s) found in the echo (line, dB): "
-             + ", ".join(f"{m} {d:+.2f}" for m, d in s["gain_steps"]), quiet or as_json)
+        report = run(config, progress=lambda _stage, _done, _total: bar.update(1))
+    for w in report.warnings:
+        info(f"sarcli: warning: {w}")
+    for line in report.lines():
+        info(line, quiet or as_json)
     if as_json:
-        out = dict(s)
-        out["output"] = str(output) if output is not None else None
-        n = len(model.blocks["range_m"])
-        out["blocks"] = [{k: model.blocks[k][i] for k in JSON_BLOCK_KEYS} for i in range(n)]
-        emit_json(out)
+        emit_json(report.to_dict())
 
 
 def register(app: typer.Typer) -> None:

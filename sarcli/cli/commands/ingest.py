@@ -12,8 +12,9 @@ from sarcli.errors import ConfigError
 
 def ingest(
     sources: list[Path] = typer.Argument(None, metavar="INPUT...",
-                                         help="A CEOS scene folder, LEADER DATA, DATA.mat PARAMS.mat, or any input "
-                                              "a sensor reader recognises."),
+                                         help="A CEOS scene folder, LEADER DATA, DATA.mat PARAMS.mat, a Sentinel-1 "
+                                              "Level-0 .dat file or .SAFE folder, or any input a sensor reader "
+                                              "recognises."),
     output: Path = typer.Option(..., "-o", "--output",
                                 help="Raw product to write (HDF5). Several data sets in the input: a folder "
                                      "(NAME.h5 each), or STEM.h5 for STEM_NAME.h5 files."),
@@ -24,7 +25,8 @@ def ingest(
     params: Path = typer.Option(None, "--params", help="Run-parameter .mat file that goes with --matlab."),
     epoch: str = typer.Option(None, "--epoch", help="MATLAB only: ISO-8601 UTC time of the first line."),
     keep_partial: bool = typer.Option(False, "--keep-partial",
-                                      help="CEOS: keep the complete lines of a truncated data file."),
+                                      help="CEOS: keep the complete lines of a truncated data file; Sentinel-1: "
+                                           "drop a trailing partial packet."),
     missing: str = typer.Option(None, "--missing",
                                 help="CEOS missing lines: zero (insert zero lines, default), repeat (previous "
                                      "line), keep."),
@@ -38,8 +40,11 @@ def ingest(
     """Ingest raw data: the sensor reader is found by sniffing the input (or named with --format).
 
     Readers: ceos-rs1 (Radarsat-1 CEOS RAW: a scene folder, or LEADER DATA), matlab-cw (a Cumming & Wong
-    MATLAB block: DATA.mat PARAMS.mat), and any installed plug-in. Reader options: --option KEY=VALUE;
-    --keep-partial, --missing, --max-gap, --f3-pulses (CEOS) and --epoch (MATLAB) are shortcuts.
+    MATLAB block: DATA.mat PARAMS.mat), sentinel1-l0 (Sentinel-1 Level-0 packets: a measurement .dat
+    file or a .SAFE folder), and any installed plug-in. Several data sets in one input (swaths,
+    polarizations): one product each, in the folder -o, or STEM_NAME.h5 for -o STEM.h5. Reader
+    options: --option KEY=VALUE; --keep-partial (CEOS, Sentinel-1), --missing, --max-gap, --f3-pulses
+    (CEOS) and --epoch (MATLAB) are shortcuts.
     Nothing is written to the inputs. CEOS: missing lines are found from the aux-block clock against
     the PRF and handled by --missing (reported); a truncated data file is refused unless --keep-partial.
 
@@ -54,6 +59,8 @@ def ingest(
       sarcli ingest --matlab rs1_vancouver_block1.mat --params rs1_vancouver_run_params.mat -o van.h5
 
       sarcli ingest demo/ceos --format ceos-rs1 --option max_gap=50 -o raw.h5 --json
+
+      sarcli ingest s1b-s3-raw-s-vv-20200615t162409.dat -o s3   (several data sets: s3/S3_VV_1.h5, ...)
     """
     sources = list(sources or [])
     if matlab is not None:

@@ -77,6 +77,7 @@ _log = logging.getLogger(__name__)
 READERS: Registry[SensorReader] = Registry("sensor reader", "sarcli.readers", {
     "ceos-rs1": "sarcli.io.readers.ceos_rs1:READER",
     "matlab-cw": "sarcli.io.readers.matlab_cw:READER",
+    "sentinel1-l0": "sarcli.io.readers.sentinel1:READER",
 }, check=_check)
 
 

@@ -1,0 +1,102 @@
+"""What the GB-SAR workflows share (not a workflow itself): the guard run before any work, the
+parameters stored in products, inputs that are images or scans, and the map / picture outputs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sarcli.config import to_mapping
+from sarcli.errors import ConfigError
+from sarcli.model.gbsar import GbsarImage
+from sarcli.workflows.base import refuse_overwriting_inputs
+
+
+def guard(inputs: Iterable[str | os.PathLike | None], outputs: Iterable[str | os.PathLike | None]) -> None:
+    """Before any work: refuse an output that is an input (same path, symbolic or hard link) and an
+    output whose folder does not exist (``None`` entries are skipped)."""
+    outputs = [p for p in outputs if p is not None]
+    refuse_overwriting_inputs(inputs, outputs)
+    for p in outputs:
+        folder = Path(p).resolve().parent
+        if not folder.is_dir():
+            raise ConfigError(f"output folder {folder} does not exist: create it first")
+
+
+def parameters(config: Any) -> dict[str, Any]:
+    """The configuration as stored in a product's ``parameters``: paths by file name only (like the
+    provenance ``inputs``), so that the same command in two folders writes the same bytes."""
+    def names(v: Any) -> Any:
+        if isinstance(v, Path):
+            return v.name
+        return [names(x) for x in v] if isinstance(v, tuple | list) else v
+
+    values = {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
+    return to_mapping({k: names(v) for k, v in values.items() if v is not None})
+
+
+def criterion_rad(criterion_deg: float) -> float:
+    """The eq. 12 phase-error criterion, given in degrees in (0, 180], in radians."""
+    if not (math.isfinite(criterion_deg) and 0 < criterion_deg <= 180):
+        raise ConfigError(f"--criterion-deg must be in (0, 180] degrees, got {criterion_deg:g}")
+    return math.radians(criterion_deg)
+
+
+def is_scan(path: str | os.PathLike) -> bool:
+    """True for a ``gbsar_scan`` product, False for a ``gbsar_image`` (anything else is refused)."""
+    from sarcli.io.h5common import attr_str, open_product
+
+    with open_product(path, ("gbsar_image", "gbsar_scan")) as f:
+        return attr_str(f, "product_type") == "gbsar_scan"
+
+
+def focus_on_the_fly(path: str | os.PathLike, like: GbsarImage | None = None) -> GbsarImage:
+    """A scan focused with ``auto`` on the grid of the image ``like`` (default grid without one: it
+    depends on the wavelength, so a delta-f pair needs ``like``)."""
+    from sarcli.gbsar.focus import Grid, image_from_scan
+    from sarcli.io.scan import read_scan
+
+    grid = Grid(ranges=like.range_m, azimuths=like.azimuth_m) if like is not None else None
+    return image_from_scan(read_scan(path), grid=grid)
+
+
+def load_image(path: str | os.PathLike, like: GbsarImage | None = None) -> GbsarImage:
+    """A focused image product, or a scan focused on the fly (:func:`focus_on_the_fly`)."""
+    if is_scan(path):
+        return focus_on_the_fly(path, like)
+    from sarcli.io.gbsar_image import read_gbsar_image
+
+    return read_gbsar_image(path)
+
+
+def slant_extent(img: GbsarImage) -> list[float]:
+    """imshow extent of a slant-plane raster: azimuth x across, range R0 down."""
+    return [img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]]
+
+
+def map_outputs(raster: np.ndarray, img: GbsarImage, geotiff: Path | None, png: Path | None, title: str, label: str,
+                cmap: str, vmin: float, vmax: float, map_pixel_m: float | None) -> dict[str, Any]:
+    """UTM GeoTIFF (nearest resampling) and slant-plane PNG of a real-valued raster on ``img``'s grid."""
+    from sarcli.gbsar.geocode import resample_to_map
+    from sarcli.io.images import write_geotiff, write_quicklook
+
+    out: dict[str, Any] = {}
+    if geotiff is not None:
+        pixel = map_pixel_m or float(img.range_m[1] - img.range_m[0])
+        m, transform, crs, ginfo = resample_to_map(raster, img.range_m, img.azimuth_m, img.site, img.rail_height_m,
+                                                   img.rail_centre_m, pixel, "utm")
+        write_geotiff(geotiff, m, crs, transform=transform, band_description=label)
+        out["geotiff"] = {"path": str(geotiff), "crs": crs, **ginfo}
+    if png is not None:
+        write_quicklook(png, raster, title=title, cmap=cmap, is_db=True, vmin=vmin, vmax=vmax,
+                        extent=slant_extent(img), xlabel="azimuth x (m)", ylabel="range R0 (m)",
+                        colorbar_label=label)
+        out["png"] = str(png)
+    return out

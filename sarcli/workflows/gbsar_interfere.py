@@ -1,0 +1,113 @@
+"""``gbsar_interfere``: two GB-SAR images (or scans) -> interferogram product (+ GeoTIFFs and PNGs).
+
+``B * conj(A)`` with the model phase of ``mode`` removed and converted (seed 003; see
+:mod:`sarcli.gbsar.interferometry`): dinsar -> LOS displacement (mm), crosstrack / combined -> height
+(m), deltaf -> range offset (m). A scan is focused with ``auto`` first, the secondary on the
+reference's grid. Pixels outside the common support are NaN; the converted value is also NaN where
+the coherence is below ``min_coherence``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from sarcli.errors import ConfigError
+from sarcli.gbsar.interferometry import MODES, interfere
+from sarcli.io.interferogram import write_interferogram
+from sarcli.workflows.base import Progress, Report, using
+from sarcli.workflows.gbsar_common import guard, load_image, map_outputs, parameters
+
+
+@dataclass(frozen=True)
+class Config:
+    """The ``sarcli gbsar interfere`` options: reference A, secondary B, output; ``pol`` default: A's
+    first; ``window``: coherence boxcar (pixels); ``ground_height_m``: the model's surface height;
+    GeoTIFF / PNG outputs of the residual phase and of the converted value."""
+
+    reference: Path
+    secondary: Path
+    output: Path
+    mode: Literal["dinsar", "crosstrack", "deltaf", "combined"] = "dinsar"
+    pol: str | None = None
+    window: int = 5
+    ground_height_m: float = 0.0
+    min_coherence: float = 0.5
+    geotiff: Path | None = None
+    png: Path | None = None
+    value_png: Path | None = None
+    value_geotiff: Path | None = None
+    map_pixel_m: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ConfigError(f"unknown interferometric mode '{self.mode}' (use {', '.join(MODES)})")
+        if self.window < 1:
+            raise ConfigError(f"the coherence window (--window) must be >= 1 pixel, got {self.window}")
+        if not 0.0 <= self.min_coherence <= 1.0:
+            raise ConfigError(f"the minimum coherence must be in [0, 1], not {self.min_coherence:g}")
+
+
+@dataclass
+class GbsarInterfereReport(Report):
+    output: str
+    attrs: dict[str, Any]
+    value: str
+    unit: str
+    rate: dict[str, float]
+    mean_coherence: float | None
+    supported_pixels: int
+    valid_value_pixels: int
+    outputs: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        from sarcli.io.h5common import to_jsonable
+
+        return to_jsonable({"output": self.output, **self.attrs, "value": self.value, "unit": self.unit,
+                            "rate": self.rate, "mean_coherence": self.mean_coherence,
+                            "supported_pixels": self.supported_pixels, "valid_value_pixels": self.valid_value_pixels,
+                            **self.outputs})
+
+    def lines(self) -> list[str]:
+        return [f"wrote {self.output}: {self.attrs['mode']}, mean coherence {self.mean_coherence or 0:.3f} over "
+                f"{self.supported_pixels} supported pixels, value {self.value} ({self.unit}) on "
+                f"{self.valid_value_pixels} with coherence >= {self.attrs['min_coherence']:g}"]
+
+
+def run(config: Config, provenance=None, progress: Progress | None = None) -> GbsarInterfereReport:
+    """Interfere ``config.secondary`` against ``config.reference``; write the product and pictures."""
+    c = config
+    with using(provenance):
+        guard([c.reference, c.secondary], [c.output, c.geotiff, c.png, c.value_png, c.value_geotiff])
+        a = load_image(c.reference)
+        b = load_image(c.secondary, like=a)
+        pol = (c.pol or a.polarizations[0]).upper()
+        ifg = interfere(a, b, c.mode, pol, c.window, c.ground_height_m, c.min_coherence)
+        attrs = {"mode": c.mode, "pol": pol, "coherence_window": c.window, "ground_height_m": c.ground_height_m,
+                 "min_coherence": c.min_coherence,
+                 "rail_height_a_m": a.rail_height_m, "rail_height_b_m": b.rail_height_m,
+                 "center_frequency_a_hz": a.center_frequency_hz, "center_frequency_b_hz": b.center_frequency_hz,
+                 "epoch_utc": a.epoch_utc}
+        write_interferogram(c.output, ifg, a.range_m, a.azimuth_m, attrs, parameters=parameters(c),
+                            inputs=[c.reference, c.secondary])
+        n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
+        outputs = map_outputs(ifg.residual, a, c.geotiff, c.png, f"{c.mode} residual phase ({pol})", "phase (rad)",
+                              "twilight", -np.pi, np.pi, c.map_pixel_m)
+        if c.value_png is not None or c.value_geotiff is not None:
+            v = ifg.value[np.isfinite(ifg.value)]
+            lo, hi = (np.percentile(v, [2, 98]) if v.size else (0.0, 1.0))
+            title = f"{c.mode} {ifg.value_name} (coherence >= {c.min_coherence:g})"
+            outputs["value_outputs"] = map_outputs(ifg.value, a, c.value_geotiff, c.value_png, title,
+                                                   f"{ifg.value_name} ({ifg.value_unit})", "viridis", float(lo),
+                                                   float(hi), c.map_pixel_m)
+        if not n_valid:
+            warnings.warn(f"no pixel has both images' support and coherence >= {c.min_coherence:g}: the value is "
+                          "all NaN", stacklevel=2)
+        return GbsarInterfereReport(
+            output=str(c.output), attrs=attrs, value=ifg.value_name, unit=ifg.value_unit, rate=ifg.rate,
+            mean_coherence=float(np.nanmean(ifg.coherence)) if ifg.support.any() else None,
+            supported_pixels=int(np.count_nonzero(ifg.support)), valid_value_pixels=n_valid, outputs=outputs)
