@@ -100,3 +100,15 @@ def test_a_failing_step_names_itself(cli, tmp_path):
     assert r.exit_code == 1 and r.stderr.strip().splitlines() == [
         f"sarcli: error: step [orbit_info]: {tmp_path / 'missing.h5'}: no such file"]
     assert (tmp_path / "raw.h5").is_file()  # the step before it ran
+
+
+def test_simulate_then_doppler_then_info(cli, tmp_path):
+    """A processing step from another area (doppler) runs from the same file; its product records the step."""
+    text = (f'[simulate]\nscene = "{SCENE}"\noutput = "OUT/raw.h5"\n\n[doppler]\nraw = "OUT/raw.h5"\n'
+            'output = "OUT/dop.h5"\noptions = { az_block = 512 }\n\n[info]\nsources = ["OUT/dop.h5"]\n')
+    r = cli("run", _steps(tmp_path, text), "--json")
+    assert r.exit_code == 0, r.stderr
+    steps = json.loads(r.stdout)["steps"]
+    assert [s["step"] for s in steps] == ["simulate", "doppler", "info"]
+    assert steps[2]["report"]["product_type"] == "doppler"
+    assert steps[2]["report"]["provenance"]["command_line"].endswith(" [doppler]")
