@@ -32,7 +32,7 @@ BLOCK = 256  # lines per block of the numpy reference decode (bounded memory)
 
 def _scene(n_lines: int):
     from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
-    from sarcli.io.ceos import aux as A
+    from sarcli.io.ceos.radarsat1 import aux as A
     from sarcli.model.raw import Orbit, Radar, RawProduct
 
     rng = np.random.default_rng(1)
@@ -56,8 +56,8 @@ def _scene(n_lines: int):
 
 def _numpy_decode(path: Path) -> np.ndarray:
     """Reference: fromfile, then gather the echo bytes of every record and decode them with numpy."""
-    from sarcli.io.ceos.datafile import index_records
-    from sarcli.io.ceos.samples import decode_reference
+    from sarcli.io.ceos.radarsat1.datafile import index_records
+    from sarcli.io.ceos.radarsat1.samples import decode_reference
 
     buf = np.fromfile(path, dtype=np.uint8)
     idx = index_records(buf, str(path))
@@ -69,8 +69,8 @@ def _numpy_decode(path: Path) -> np.ndarray:
 
 
 def main() -> None:
-    from sarcli.io.ceos import read_ceos, write_ceos
-    from sarcli.io.ceos.samples import decode_lines
+    from sarcli.io.ceos.radarsat1 import read_ceos, write_ceos
+    from sarcli.io.ceos.radarsat1.samples import decode_lines
 
     rows = []
     data = {"n_samples": N_SAMPLES, "runs": []}

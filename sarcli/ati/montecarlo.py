@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ConfigError, SarcliError
 
 KEYS = ("vy", "x0", "y0")
 
@@ -30,7 +30,7 @@ def parse_snr_range(spec: str) -> list[float]:
             return [float(v) for v in np.arange(a, b + 0.5 * c, c)]
         return [float(x) for x in spec.split(",")]
     except ValueError:
-        raise SarcliError(f"--snr {spec!r}: expected start:stop:step (dB) with step > 0, or a comma list") from None
+        raise ConfigError(f"snr {spec!r}: expected start:stop:step (dB) with step > 0, or a comma list") from None
 
 
 def _scene_at(scene, snr_db: float, run_seed: int):
@@ -84,7 +84,7 @@ def run(scene_path: str, runs: int, snrs: list[float], seed: int, route: str = "
     from sarcli.sim.scene import load_scene
 
     if runs < 1:
-        raise SarcliError("--runs must be at least 1")
+        raise ConfigError("runs must be at least 1")
     scene = load_scene(scene_path)
     table = []
     for i, snr in enumerate(snrs):

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-import warnings
+from pathlib import Path
 
 import typer
 
 from sarcli import __version__
 from sarcli.cli import commands
-from sarcli.cli.common import make_typer
+from sarcli.cli.common import make_typer, terminal
 
 app = make_typer(
     help=(
@@ -22,7 +22,9 @@ app = make_typer(
         "Examples:\n\n"
         "  sarcli simulate samples/rs1_point.toml -o raw.h5\n\n"
         "  sarcli info raw.h5 --json\n\n"
-        "Run 'sarcli COMMAND --help' for a command's options and examples."
+        "  sarcli -v --log-file run.log run steps.toml\n\n"
+        "Run 'sarcli COMMAND --help' for a command's options and examples. Exit status: 0 done, 1 bad data, "
+        "2 usage or configuration, 3 instrument fault, 130 interrupted."
     ),
 )
 
@@ -35,10 +37,19 @@ def _print_version(value: bool) -> None:
 
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
                                  help="Print the version and exit."),
+    verbose: int = typer.Option(0, "--verbose", "-v", count=True,
+                                help="Show diagnostics on stderr: -v progress of each step, -vv debugging detail."),
+    quiet: bool = typer.Option(False, "--quiet", "-q",
+                               help="Hide status lines and progress bars (results, warnings and errors stay)."),
+    log_file: Path = typer.Option(None, "--log-file", dir_okay=False, metavar="PATH",
+                                  help="Append every diagnostic (DEBUG), status line, warning and error, "
+                                       "with times, to this file."),
 ) -> None:
     """sarcli command line."""
+    ctx.with_resource(terminal(verbose, quiet, log_file))
 
 
 def _register_all() -> None:
@@ -50,14 +61,6 @@ def _register_all() -> None:
 _register_all()
 
 
-def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Warnings reach a person as one line, like errors: ``sarcli: warning: ...``."""
-    import sys
-
-    print(f"sarcli: warning: {message}", file=sys.stderr if file is None else file)
-
-
 def main() -> None:
     """Console-script entry point."""
-    warnings.showwarning = _one_line_warning
     app()

@@ -1,22 +1,50 @@
-"""Helpers shared by all commands: one-line errors, JSON output, progress bars, typer factory."""
+"""Helpers shared by all commands: one-line errors, JSON output, progress bars, typer factory, running a
+workflow from a command's options, and what reaches the terminal (``--verbose``, ``--quiet``,
+``--log-file``).
+
+Streams: a command's result goes to stdout (``sarcli info f.h5 | less``, ``--json``); status lines,
+warnings (``sarcli: warning: ...``), diagnostics and errors (``sarcli: error: ...``) go to stderr.
+Diagnostics are the ``logging`` records of sarcli's modules (``logging.getLogger(__name__)``): hidden by
+default, ``-v`` shows INFO, ``-vv`` DEBUG. ``--quiet`` hides status lines and progress bars (warnings and
+errors stay). ``--log-file PATH`` appends everything (DEBUG diagnostics, status lines, warnings, the
+error) with timestamps, whatever the terminal shows.
+
+Nothing here imports numpy, h5py or scipy: ``sarcli --help`` stays fast.
+"""
 
 from __future__ import annotations
 
 import json
+import logging
 import os
+import re
 import sys
-from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
+import warnings
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
 from typing import Any, TypeVar
 
 import typer
 from typer.core import TyperGroup
 
 from orbit.errors import OrbitError
-from sarcli.errors import InstrumentError, Interrupted, ProductError, SarcliError
-from sarcli.io.h5common import to_jsonable
+from sarcli.errors import ConfigError, InstrumentError, Interrupted, ProductError, SarcliError
 
 T = TypeVar("T")
+
+#: loggers whose records are sarcli diagnostics (the ``orbit`` package is sarcli's geometry)
+LOGGERS = ("sarcli", "orbit")
+_LOG_FORMAT_TERMINAL = "sarcli: %(levelname_lower)s: %(name)s: %(message)s"
+_LOG_FORMAT_FILE = "%(asctime)s %(levelname)s %(name)s: %(message)s"
+_log = logging.getLogger("sarcli.cli")
+
+
+class _Terminal:
+    """What the current invocation shows (set by the root command's options)."""
+
+    quiet = False
+    log_file: logging.Handler | None = None
 
 
 EXIT_USAGE, EXIT_DATA, EXIT_INSTRUMENT, EXIT_INTERRUPT = 2, 1, 3, 130
@@ -36,6 +64,7 @@ def exit_code_for(error: BaseException) -> int:
 def fail(message: str, exit_code: int = EXIT_USAGE) -> typer.Exit:
     """Print ``sarcli: error: message`` on stderr and return the Exit to raise."""
     typer.echo(f"sarcli: error: {message}", err=True)
+    _to_log_file(logging.ERROR, f"error (exit {exit_code}): {message}")
     return typer.Exit(exit_code)
 
 
@@ -78,6 +107,8 @@ def make_typer(**kwargs: Any) -> typer.Typer:
 
 def emit_json(obj: Any) -> None:
     """Print one JSON document on stdout (numpy types converted, NaN -> null)."""
+    from sarcli.io.h5common import to_jsonable  # numpy: only once there is a result to print
+
     sys.stdout.write(json.dumps(to_jsonable(obj), indent=2, sort_keys=False) + "\n")
     sys.stdout.flush()
 
@@ -97,13 +128,15 @@ def report(msg: str) -> None:
 
 
 def info(msg: str, quiet: bool = False) -> None:
-    """Human-readable progress/status line on stderr (stdout stays clean for --json)."""
-    if not quiet:
+    """Human-readable progress/status line on stderr (stdout stays clean for --json); hidden by
+    ``--quiet`` (and by ``quiet``), always in the ``--log-file``."""
+    _to_log_file(logging.INFO, msg)
+    if not (quiet or _Terminal.quiet):
         typer.echo(msg, err=True)
 
 
 def _progress_enabled(disable: bool) -> bool:
-    if disable or os.environ.get("SARCLI_NO_PROGRESS"):
+    if disable or _Terminal.quiet or os.environ.get("SARCLI_NO_PROGRESS"):
         return False
     return sys.stderr.isatty()
 
@@ -129,3 +162,178 @@ def progress_bar(total: int, label: str = "", disable: bool = False) -> Iterator
         return
     with typer.progressbar(length=total, label=label, file=sys.stderr, show_eta=True) as bar:
         yield bar
+
+
+@contextmanager
+def progress_sink(disable: bool = False) -> Iterator[Any]:
+    """A workflow's ``progress(label, done, total)`` drawn as one bar per label on stderr (a terminal
+    only; nothing under ``--quiet`` or ``SARCLI_NO_PROGRESS``)."""
+    if not _progress_enabled(disable):
+        yield None
+        return
+    with ExitStack() as stack:
+        bars: dict[str, Any] = {}
+
+        def sink(label: str, done: int, total: int) -> None:
+            bar = bars.get(label)
+            if bar is None:
+                bar = bars[label] = stack.enter_context(
+                    typer.progressbar(length=max(total, 1), label=label, file=sys.stderr, show_eta=True))
+            bar.update(max(0, done - bar.pos))
+
+        yield sink
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Running a workflow from a command's options
+
+
+_FIELD = re.compile(r"^([a-z][a-z0-9_]*)(?=:| must | ')")
+
+
+def name_options(message: str, flags: Mapping[str, str]) -> str:
+    """A configuration message that starts with a field name (``max_gap must be ...``, ``route: 'x' is
+    not one of ...``, ``route 'x': choose ...``) reworded to name the command-line option as typed
+    (``--max-gap must be ...``); other messages (``output folder ... does not exist``) are kept."""
+    m = _FIELD.match(message)
+    if m and m.group(1) in flags:
+        return flags[m.group(1)] + message[m.end():]
+    return message
+
+
+def run_workflow(step: str, options: Mapping[str, Any], flags: Mapping[str, str] | None = None,
+                 progress_disabled: bool = False) -> Any:
+    """Build workflow ``step``'s ``Config`` from a command's options (``None``: not given, the default
+    applies), run it with a progress bar, return its report. Configuration messages name the options as
+    typed: a field ``max_gap`` is ``--max-gap`` unless ``flags`` says otherwise (``{"raw": "RAW"}``).
+    The provenance is the command line (set for the whole invocation by :class:`SarcliGroup`)."""
+    import dataclasses
+
+    from sarcli.config import from_mapping
+    from sarcli.workflows import WORKFLOWS
+
+    module = WORKFLOWS.get(step)
+    names = {f.name: "--" + f.name.replace("_", "-") for f in dataclasses.fields(module.Config)}
+    names.update(flags or {})
+    try:
+        config = from_mapping(module.Config, {k: v for k, v in options.items() if v is not None}, where="")
+        _log.debug("workflow %s: %r", step, config)
+        with progress_sink(progress_disabled) as sink:
+            return module.run(config, progress=sink)
+    except ConfigError as e:
+        raise ConfigError(name_options(str(e), names)) from None
+
+
+def parse_option_values(items: Iterable[str], flag: str = "--option") -> dict[str, Any]:
+    """``KEY=VALUE`` strings -> a mapping; VALUE is read as a TOML value when it is one (``true``, ``12``,
+    ``1.5``, ``"text"``, ``[1, 2]``), else kept as text (``missing=repeat``)."""
+    import tomllib
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ConfigError(f"{flag} {item!r}: expected KEY=VALUE")
+        try:
+            out[key] = tomllib.loads(f"v = {value.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            out[key] = value.strip()
+    return out
+
+
+def print_report(report: Any, as_json: bool) -> None:
+    """A workflow report as the command's result: ``--json`` -> its ``to_dict()``, else its ``lines()``,
+    on stdout."""
+    if as_json:
+        emit_json(report.to_dict())
+        return
+    for line in report.lines():
+        typer.echo(line)
+
+
+def print_status(report: Any) -> None:
+    """A workflow report's ``lines()`` as status lines on stderr (hidden by ``--quiet``): for commands
+    whose result is a file, or whose ``--json`` goes to stdout alongside."""
+    for line in report.lines():
+        info(line)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# What reaches the terminal and the log file
+
+
+class _LowerLevel(logging.Formatter):
+    def format(self, record: logging.LogRecord) -> str:
+        record.levelname_lower = record.levelname.lower()
+        return super().format(record)
+
+
+class _StderrHandler(logging.Handler):
+    """Writes to the *current* ``sys.stderr`` (the test runner swaps it per invocation)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            print(self.format(record), file=sys.stderr)
+        except Exception:  # noqa: BLE001 (logging's own contract: never raise from a handler)
+            self.handleError(record)
+
+
+def _to_log_file(level: int, message: str) -> None:
+    h = _Terminal.log_file
+    if h is not None:
+        h.handle(_log.makeRecord(_log.name, level, "(cli)", 0, message, None, None))
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings reach a person as one line, like errors: ``sarcli: warning: ...`` (and the log file)."""
+    text = " ".join(str(message).split())
+    _to_log_file(logging.WARNING, f"warning: {text} ({category.__name__}, {filename}:{lineno})")
+    print(f"sarcli: warning: {text}", file=sys.stderr if file is None else file)
+
+
+@contextmanager
+def terminal(verbose: int = 0, quiet: bool = False, log_file: Path | None = None) -> Iterator[None]:
+    """For one invocation: diagnostics at WARNING (default), INFO (``verbose`` 1) or DEBUG (2+) on
+    stderr; ``quiet`` hides status lines and progress bars; ``log_file`` appends everything at DEBUG.
+    Warnings are shown as one line each (once per place in the code). Undone on exit."""
+    if verbose and quiet:
+        raise ConfigError("--verbose and --quiet exclude each other")
+    level = logging.DEBUG if verbose >= 2 else logging.INFO if verbose == 1 else logging.WARNING
+    handlers: list[logging.Handler] = []
+    stderr = _StderrHandler(level)
+    stderr.setFormatter(_LowerLevel(_LOG_FORMAT_TERMINAL))
+    handlers.append(stderr)
+    file_handler = None
+    if log_file is not None:
+        try:
+            file_handler = logging.FileHandler(log_file, mode="a", encoding="utf-8")
+        except OSError as e:
+            raise ConfigError(f"--log-file {log_file}: cannot open ({e.strerror})") from None
+        file_handler.setLevel(logging.DEBUG)
+        file_handler.setFormatter(logging.Formatter(_LOG_FORMAT_FILE))
+        handlers.append(file_handler)
+    saved = []
+    for name in LOGGERS:
+        lg = logging.getLogger(name)
+        saved.append((lg, lg.level, lg.propagate))
+        lg.setLevel(min(h.level for h in handlers))
+        lg.propagate = False
+        for h in handlers:
+            lg.addHandler(h)
+    _Terminal.quiet, _Terminal.log_file = quiet, file_handler
+    _to_log_file(logging.INFO, f"command: {command_line()}")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = _one_line_warning
+            yield
+    finally:
+        _Terminal.quiet, _Terminal.log_file = False, None
+        for lg, lvl, prop in saved:
+            for h in handlers:
+                lg.removeHandler(h)
+            lg.setLevel(lvl)
+            lg.propagate = prop
+        if file_handler is not None:
+            file_handler.close()

@@ -28,30 +28,37 @@ ranges_m (the ranges at which to evaluate resolution).
 
 from __future__ import annotations
 
+import dataclasses
 import math
-import tomllib
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
-from sarcli.errors import SarcliError
+from sarcli.config import from_mapping, load_toml
+from sarcli.errors import ConfigError, ProductError
 from sarcli.model.constants import C_LIGHT, WGS84_A
 
 PLATFORMS = ("airborne", "spaceborne", "gbsar")
 
 
-@dataclass
+@dataclass(frozen=True)
 class Processor:
+    """The AOD/CCD optical processor of seed 004 (all optional): CCD rows and line rate, AOD aperture (m)
+    and acoustic velocity (m/s)."""
+
     ccd_rows: int | None = None
     ccd_line_rate_hz: float | None = None
     aod_aperture_m: float | None = None
     aod_velocity_mps: float | None = None
 
 
-@dataclass
-class DesignParams:
-    platform: str
+@dataclass(frozen=True)
+class DesignTable:
+    """The ``[design]`` table of a design TOML (module docstring); SI units, angles in degrees."""
+
+    platform: Literal["airborne", "spaceborne", "gbsar"]
     carrier_frequency_hz: float
     chirp_rate_hz_per_s: float | None = None
     pulse_length_s: float | None = None
@@ -59,12 +66,12 @@ class DesignParams:
     altitude_m: float | None = None
     velocity_mps: float | None = None
     look_angle_deg: float | None = None
-    look_angle_from: str = "horizontal"
+    look_angle_from: Literal["horizontal", "nadir"] = "horizontal"
     squint_angle_deg: float = 90.0
     antenna_length_m: float | None = None
     swath_slant_m: float | None = None
     slant_range_m: float | None = None
-    prf_hz: list[float] = field(default_factory=list)
+    prf_hz: tuple[float, ...] = ()
     processor: Processor = field(default_factory=Processor)
     # GB-SAR
     frequency_start_hz: float | None = None
@@ -74,7 +81,13 @@ class DesignParams:
     rail_step_m: float | None = None
     beamwidth_deg: float | None = None
     antenna_height_m: float = 0.0
-    ranges_m: list[float] = field(default_factory=list)
+    ranges_m: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class DesignParams(DesignTable):
+    """A design: the table's parameters and where they came from (``source``: a file name)."""
+
     source: str = ""
 
     @property
@@ -83,69 +96,48 @@ class DesignParams:
 
 
 def _need(p: DesignParams, names: tuple[str, ...], where: str) -> None:
-    missing = [n for n in names if getattr(p, n) in (None, [])]
+    missing = [n for n in names if getattr(p, n) in (None, (), [])]
     if missing:
-        raise SarcliError(f"{where}: a {p.platform} design needs {', '.join(missing)}")
+        raise ConfigError(f"{where}: a {p.platform} design needs {', '.join(missing)}")
 
 
 def validate(p: DesignParams, where: str) -> DesignParams:
-    """Check completeness and ranges; one-line SarcliError on the first problem."""
+    """Check completeness and ranges; one-line ConfigError on the first problem."""
     if p.platform not in PLATFORMS:
-        raise SarcliError(f"{where}: platform must be one of {', '.join(PLATFORMS)}, got {p.platform!r}")
+        raise ConfigError(f"{where}: platform must be one of {', '.join(PLATFORMS)}, got {p.platform!r}")
     if not (p.carrier_frequency_hz and p.carrier_frequency_hz > 0):
-        raise SarcliError(f"{where}: carrier_frequency_hz must be positive")
+        raise ConfigError(f"{where}: carrier_frequency_hz must be positive")
     if p.platform == "gbsar":
         _need(p, ("frequency_start_hz", "frequency_stop_hz", "n_frequencies", "rail_length_m",
                   "rail_step_m", "antenna_length_m", "beamwidth_deg"), where)
         if p.frequency_stop_hz <= p.frequency_start_hz or p.n_frequencies < 2:
-            raise SarcliError(f"{where}: need frequency_stop_hz > frequency_start_hz and n_frequencies >= 2")
+            raise ConfigError(f"{where}: need frequency_stop_hz > frequency_start_hz and n_frequencies >= 2")
         return p
     if p.bandwidth_hz is None:
         _need(p, ("chirp_rate_hz_per_s", "pulse_length_s"), where)
     _need(p, ("pulse_length_s", "altitude_m", "velocity_mps", "look_angle_deg", "prf_hz"), where)
-    if p.look_angle_from not in ("horizontal", "nadir"):
-        raise SarcliError(f"{where}: look_angle_from must be 'horizontal' or 'nadir'")
     if not 0 < p.look_angle_deg < 90:
-        raise SarcliError(f"{where}: look_angle_deg must lie strictly between 0 and 90")
+        raise ConfigError(f"{where}: look_angle_deg must lie strictly between 0 and 90")
     if not 0 < p.squint_angle_deg <= 90:
-        raise SarcliError(f"{where}: squint_angle_deg must lie in (0, 90]")
+        raise ConfigError(f"{where}: squint_angle_deg must lie in (0, 90]")
     if any(not (f > 0) for f in p.prf_hz):
-        raise SarcliError(f"{where}: every prf_hz must be positive")
+        raise ConfigError(f"{where}: every prf_hz must be positive")
     for name in ("altitude_m", "velocity_mps", "pulse_length_s"):
         if not getattr(p, name) > 0:
-            raise SarcliError(f"{where}: {name} must be positive")
+            raise ConfigError(f"{where}: {name} must be positive")
     return p
 
 
-def _read_toml(path: Path) -> dict:
-    try:
-        return tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise SarcliError(f"{path}: not valid TOML ({e})") from None
-
-
 def from_toml(path: str | Path, doc: dict | None = None) -> DesignParams:
-    """Read the ``[design]`` table of a TOML file (``doc``: the file already parsed)."""
+    """Read the ``[design]`` table of a TOML file (``doc``: the file already parsed) with
+    :func:`sarcli.config.from_mapping`: unknown keys, wrong types and unknown choices are one line naming
+    the file and the key (``d.toml: design.platform: 'boat' is not one of ...``)."""
     path = Path(path)
-    doc = _read_toml(path) if doc is None else doc
+    doc = load_toml(path) if doc is None else doc
     if "design" not in doc:
-        raise SarcliError(f"{path}: no [design] table (see samples/aod_ccd_example.toml)")
-    d = dict(doc["design"])
-    proc_table = dict(d.pop("processor", {}))
-    proc_known = {f.name for f in fields(Processor)}
-    extra = sorted(set(proc_table) - proc_known)
-    if extra:
-        raise SarcliError(f"{path}: unknown [design.processor] key(s) {', '.join(extra)}; "
-                          f"known: {', '.join(sorted(proc_known))}")
-    proc = Processor(**proc_table)
-    known = {f.name for f in fields(DesignParams)} - {"processor", "source"}
-    unknown = sorted(set(d) - known)
-    if unknown:
-        raise SarcliError(f"{path}: unknown design key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-    for required in ("platform", "carrier_frequency_hz"):
-        if required not in d:
-            raise SarcliError(f"{path}: [design] {required} is required")
-    p = DesignParams(processor=proc, source=path.name, **d)
+        raise ConfigError(f"{path}: no [design] table (see samples/aod_ccd_example.toml)")
+    table = from_mapping(DesignTable, doc["design"], where=f"{path}: design")
+    p = DesignParams(**{f.name: getattr(table, f.name) for f in dataclasses.fields(table)}, source=path.name)
     return validate(p, str(path))
 
 
@@ -191,17 +183,17 @@ def from_raw(path: str | Path) -> DesignParams:
         look = math.degrees(math.asin(min(1.0, height / centre_range)))
         look_from = "horizontal"
     else:
-        raise SarcliError(f"{path}: the product has no orbit; a design needs platform height and speed")
+        raise ProductError(f"{path}: the product has no orbit; a design needs platform height and speed")
     a = max(0, n_lines // 2 - 2048)
     c = max(0, n_samples // 2 - 256)
     block = read_raw_echo_block(path, a, a + 4096)[:, c:c + 512]
     if not np.any(block):
-        raise SarcliError(f"{path}: the echo is all zero; its Doppler bandwidth (antenna length) cannot be measured")
+        raise ProductError(f"{path}: the echo is all zero; its Doppler bandwidth (antenna length) cannot be measured")
     antenna = 2.0 * speed / doppler_bandwidth(block, r.prf_hz)
     p = DesignParams(platform=platform, carrier_frequency_hz=r.carrier_frequency_hz, antenna_length_m=antenna,
                      chirp_rate_hz_per_s=r.chirp_rate_hz_per_s, pulse_length_s=r.pulse_length_s,
                      altitude_m=height, velocity_mps=speed, look_angle_deg=look, look_angle_from=look_from,
-                     swath_slant_m=swath, slant_range_m=centre_range, prf_hz=[r.prf_hz],
+                     swath_slant_m=swath, slant_range_m=centre_range, prf_hz=(r.prf_hz,),
                      source=Path(path).name)
     return validate(p, str(path))
 
@@ -214,7 +206,7 @@ def from_scan(path: str | Path) -> DesignParams:
     f = s.frequency
     x = s.rail_position
     if f.size < 2 or x.size < 2:
-        raise SarcliError(f"{path}: a design needs at least 2 frequencies and 2 rail stops")
+        raise ProductError(f"{path}: a design needs at least 2 frequencies and 2 rail stops")
     p = DesignParams(platform="gbsar", carrier_frequency_hz=float(f.mean()),
                      frequency_start_hz=float(f[0]), frequency_stop_hz=float(f[-1]), n_frequencies=int(f.size),
                      rail_length_m=float(x[-1] - x[0]), rail_step_m=float(np.median(np.diff(x))),
@@ -246,7 +238,7 @@ def from_stripmap_scene(path: str | Path) -> DesignParams:
                      chirp_rate_hz_per_s=r.chirp_rate_hz_per_s, pulse_length_s=r.pulse_length_s,
                      altitude_m=height, velocity_mps=speed, look_angle_deg=math.degrees(ant.look_angle_rad),
                      look_angle_from="nadir", antenna_length_m=ant.length_m, swath_slant_m=swath,
-                     slant_range_m=centre, prf_hz=[r.prf_hz], source=Path(path).name)
+                     slant_range_m=centre, prf_hz=(r.prf_hz,), source=Path(path).name)
     return validate(p, str(path))
 
 
@@ -270,9 +262,9 @@ def load(path: str | Path) -> DesignParams:
     """Design parameters from a design TOML, a stripmap or GB-SAR scene, a raw product or a GB-SAR scan."""
     path = Path(path)
     if not path.exists():
-        raise SarcliError(f"{path}: no such file")
+        raise ConfigError(f"{path}: no such file")
     if path.suffix.lower() == ".toml":
-        doc = _read_toml(path)
+        doc = load_toml(path)
         if "design" in doc or not ("platform" in doc or "rail" in doc):
             return from_toml(path, doc)
         return from_stripmap_scene(path) if "platform" in doc else from_gbsar_scene(path)
@@ -284,4 +276,4 @@ def load(path: str | Path) -> DesignParams:
         return from_raw(path)
     if ptype == "gbsar_scan":
         return from_scan(path)
-    raise SarcliError(f"{path}: a '{ptype}' product carries no design; give a raw, gbsar_scan or design TOML")
+    raise ProductError(f"{path}: a '{ptype}' product carries no design; give a raw, gbsar_scan or design TOML")

@@ -36,7 +36,7 @@ import scipy.io
 
 from orbit.timeutil import format_utc, parse_utc
 from sarcli.errors import FormatError
-from sarcli.io.ceos.samples import is_four_bit
+from sarcli.io.ceos.radarsat1.samples import is_four_bit
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import Radar, RawProduct
 

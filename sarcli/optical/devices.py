@@ -76,16 +76,16 @@ class OpticalSettings:
     seed: int = 0  # read noise of the ``adc`` limitation
 
     def __post_init__(self) -> None:
-        from sarcli.errors import SarcliError
+        from sarcli.errors import ConfigError
 
         if self.reference_offset_hz is not None and not self.reference_offset_hz > 0:
-            raise SarcliError(f"reference offset must be a positive frequency (Hz), got {self.reference_offset_hz}")
+            raise ConfigError(f"reference offset must be a positive frequency (Hz), got {self.reference_offset_hz}")
         if self.magnification not in ("carrier", "fit_aod"):
-            raise SarcliError(f"magnification must be 'carrier' or 'fit_aod', not {self.magnification!r}")
+            raise ConfigError(f"magnification must be 'carrier' or 'fit_aod', not {self.magnification!r}")
         if not self.light_pulse_s > 0 or not self.reference_ratio > 0:
-            raise SarcliError("light_pulse_s and reference_ratio must be positive")
+            raise ConfigError("light_pulse_s and reference_ratio must be positive")
         if not 1 <= self.ccd.adc_bits <= 24 or self.ccd.rows < 3 or self.ccd.columns < 8:
-            raise SarcliError("CCD: adc_bits must be 1..24, rows >= 3, columns >= 8")
+            raise ConfigError("CCD: adc_bits must be 1..24, rows >= 3, columns >= 8")
 
 
 @dataclass(frozen=True)

@@ -1,109 +1,193 @@
 """Scene files (TOML) -> validated dataclasses for the stripmap simulator.
 
 A scene lists radar, antenna, platform, targets, clutter patches and an explicit list of effects;
-the simulator computes only the listed effects. Every mistake (unknown key, unknown effect, wrong
-type, impossible value) is a one-line :class:`sarcli.errors.FormatError` naming the file and key.
+the simulator computes only the listed effects. Each table is parsed with :func:`sarcli.config.from_mapping`
+into a frozen dataclass (``_RadarTable``, ...), then checked for finite numbers and ranges: every mistake
+(unknown key, unknown effect, wrong type, impossible value) is a one-line :class:`sarcli.errors.ConfigError`
+naming the file and the key (``scene.toml: radar.n_lines: must be an integer >= 1, got -3``).
 Units: SI; angles in degrees in the file (``*_deg`` keys), radians in the dataclasses.
 Times: seconds after ``scene.epoch_utc``; target azimuth times are relative to the scene centre.
-See the README (section ``sarcli simulate``) for the format with examples.
+See ``docs/simulate.md`` for the format with examples.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-import tomllib
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
 from orbit.propagate import Keplerian
-from sarcli.errors import ConfigError, FormatError
+from sarcli.config import from_mapping, load_toml
+from sarcli.errors import ConfigError
 from sarcli.model.constants import C_LIGHT
 
 PLATFORM_TYPES = ("orbit", "state_vectors", "linear")
+T = TypeVar("T")
 
 
-class _Table:
-    """Strict accessor for one TOML table: typed gets, and an error for keys nobody read."""
+def _numbers(v: Any) -> Iterable[float]:
+    if isinstance(v, float):
+        yield v
+    elif isinstance(v, tuple | list):
+        for x in v:
+            yield from _numbers(x)
 
-    def __init__(self, data: Any, where: str, src: str):
-        if not isinstance(data, dict):
-            raise FormatError(f"{src}: [{where}] must be a table")
-        self.data, self.where, self.src, self.used = data, where, src, set()
 
-    def err(self, key: str, msg: str) -> FormatError:
-        return FormatError(f"{self.src}: [{self.where}] {key}: {msg}")
+def table(cls: type[T], data: Any, where: str, positive: tuple[str, ...] = (), nonneg: tuple[str, ...] = (),
+          at_least: Mapping[str, int] | None = None) -> T:
+    """``cls`` from one TOML table (``where``: ``"file.toml: radar"``), with every number finite, the
+    ``positive`` fields > 0, the ``nonneg`` fields >= 0 and the ``at_least`` integers >= their bound
+    (``None``, "not given", passes)."""
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{where} must be a table")
+    obj = from_mapping(cls, data, where)
+    for f in dataclasses.fields(obj):  # type: ignore[arg-type]
+        v = getattr(obj, f.name)
+        for x in _numbers(v):
+            if not math.isfinite(x):
+                raise ConfigError(f"{where}.{f.name}: expected a finite number, got {x!r}")
+        if v is None:
+            continue
+        if f.name in positive and not v > 0:
+            raise ConfigError(f"{where}.{f.name}: must be > 0, got {v!r}")
+        if f.name in nonneg and not v >= 0:
+            raise ConfigError(f"{where}.{f.name}: must be >= 0, got {v!r}")
+        if at_least and f.name in at_least and v < at_least[f.name]:
+            raise ConfigError(f"{where}.{f.name}: must be an integer >= {at_least[f.name]}, got {v!r}")
+    return obj
 
-    def has(self, key: str) -> bool:
-        return key in self.data
 
-    def num(self, key: str, default: float | None = None, *, positive: bool = False,
-            nonneg: bool = False) -> float:
-        self.used.add(key)
-        if key not in self.data:
-            if default is None:
-                raise self.err(key, "required number is missing")
-            return float(default)
-        v = self.data[key]
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise self.err(key, f"expected a finite number, got {v!r}")
-        if positive and v <= 0:
-            raise self.err(key, f"must be > 0, got {v!r}")
-        if nonneg and v < 0:
-            raise self.err(key, f"must be >= 0, got {v!r}")
-        return float(v)
+# ---------------------------------------------------------------------------------------------------------
+# The tables of a scene file, as written (SI units, degrees)
 
-    def opt_num(self, key: str, **kw: Any) -> float | None:
-        return self.num(key, **kw) if key in self.data else None
 
-    def int(self, key: str, default: int | None = None, *, minimum: int = 1) -> int:
-        self.used.add(key)
-        if key not in self.data:
-            if default is None:
-                raise self.err(key, "required integer is missing")
-            return default
-        v = self.data[key]
-        if isinstance(v, bool) or not isinstance(v, int) or v < minimum:
-            raise self.err(key, f"expected an integer >= {minimum}, got {v!r}")
-        return v
+@dataclass(frozen=True, kw_only=True)
+class _SceneTable:
+    seed: int
+    name: str | None = None
+    epoch_utc: str = "2000-01-01T12:00:00Z"
+    center_time_s: float = 0.0
+    reference_height_m: float = 0.0
+    clutter_model: Literal["binned", "exact"] = "binned"
+    clutter_oversampling: int = 4
+    effects: tuple[str, ...] = ()
+    description: str = ""
 
-    def str(self, key: str, default: str | None = None, choices: tuple[str, ...] | None = None) -> str:
-        self.used.add(key)
-        if key not in self.data:
-            if default is None:
-                raise self.err(key, "required string is missing")
-            return default
-        v = self.data[key]
-        if not isinstance(v, str):
-            raise self.err(key, f"expected a string, got {v!r}")
-        if choices is not None and v not in choices:
-            raise self.err(key, f"{v!r} is not one of {', '.join(choices)}")
-        return v
 
-    def array(self, key: str, shape_tail: tuple[int, ...] = ()) -> np.ndarray:
-        self.used.add(key)
-        if key not in self.data:
-            raise self.err(key, "required array is missing")
-        try:
-            a = np.asarray(self.data[key], dtype=np.float64)
-        except (TypeError, ValueError):
-            raise self.err(key, "expected an array of numbers") from None
-        if a.ndim != 1 + len(shape_tail) or a.shape[1:] != shape_tail or not np.all(np.isfinite(a)):
-            raise self.err(key, f"expected finite numbers of shape (n,{','.join(map(str, shape_tail))})")
-        return a
+@dataclass(frozen=True, kw_only=True)
+class _RadarTable:
+    carrier_frequency_hz: float
+    prf_hz: float
+    range_sampling_rate_hz: float
+    chirp_rate_hz_per_s: float
+    pulse_length_s: float
+    n_lines: int
+    n_samples: int
+    window_start_s: float | None = None
+    first_range_m: float | None = None
+    look_side: Literal["right", "left"] = "right"
 
-    def sub(self, key: str) -> _Table | None:
-        self.used.add(key)
-        where = key if self.where == "" else f"{self.where}.{key}"
-        return _Table(self.data[key], where, self.src) if key in self.data else None
 
-    def finish(self) -> None:
-        extra = sorted(set(self.data) - self.used)
-        if extra:
-            where = f"[{self.where}]" if self.where else "top level:"
-            raise FormatError(f"{self.src}: {where} unknown key(s): {', '.join(extra)}")
+@dataclass(frozen=True, kw_only=True)
+class _AntennaTable:
+    length_m: float
+    height_m: float
+    look_angle_deg: float
+    beam_extent: float = 1.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _OrbitTable:
+    type: str
+    semi_major_axis_m: float
+    eccentricity: float
+    inclination_deg: float
+    raan_deg: float
+    arg_perigee_deg: float
+    mean_anomaly_deg: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class _StateVectorTable:
+    type: str
+    frame: Literal["ECI", "ECEF"]
+    time_s: tuple[float, ...]
+    position_m: tuple[tuple[float, float, float], ...]
+    velocity_mps: tuple[tuple[float, float, float], ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class _LinearTable:
+    type: str
+    velocity_mps: float
+    height_m: float
+    x_m: float = 0.0
+    y_m: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _LocalPlace:
+    """A position on a linear-platform (flat-Earth LOCAL) scene."""
+
+    x_m: float
+    y_m: float
+    z_m: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _EarthPlace:
+    """A position on an orbit scene: geodetic (lat_deg, lon_deg, height_m), or slant (slant_range_m at
+    azimuth_time_s, height_m)."""
+
+    lat_deg: float | None = None
+    lon_deg: float | None = None
+    slant_range_m: float | None = None
+    azimuth_time_s: float = 0.0
+    height_m: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _LocalTarget(_LocalPlace):
+    amplitude: float = 1.0
+    phase_deg: float = 0.0
+    vx_mps: float = 0.0
+    vy_mps: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _EarthTarget(_EarthPlace):
+    amplitude: float = 1.0
+    phase_deg: float = 0.0
+    v_east_mps: float = 0.0
+    v_north_mps: float = 0.0
+    v_up_mps: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Patch:
+    range_extent_m: float
+    azimuth_extent_m: float
+    sigma0_db: float
+    density_per_m2: float
+
+
+@dataclass(frozen=True, kw_only=True)
+class _LocalClutter(_LocalPlace, _Patch):
+    pass
+
+
+@dataclass(frozen=True, kw_only=True)
+class _EarthClutter(_EarthPlace, _Patch):
+    pass
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The validated scene
 
 
 @dataclass(frozen=True)
@@ -221,173 +305,158 @@ class Scene:
     clutter_oversampling: int = 4
 
 
-def _radar(t: _Table) -> RadarConfig:
-    fs = t.num("range_sampling_rate_hz", positive=True)
-    ws = t.opt_num("window_start_s", positive=True)
-    r0 = t.opt_num("first_range_m", positive=True)
-    if (ws is None) == (r0 is None):
-        raise t.err("window_start_s", "give exactly one of window_start_s or first_range_m")
-    k = t.num("chirp_rate_hz_per_s")
-    if k == 0:
-        raise t.err("chirp_rate_hz_per_s", "must be non-zero (sign = chirp direction)")
-    r = RadarConfig(
-        carrier_frequency_hz=t.num("carrier_frequency_hz", positive=True),
-        prf_hz=t.num("prf_hz", positive=True),
-        range_sampling_rate_hz=fs,
-        chirp_rate_hz_per_s=k,
-        pulse_length_s=t.num("pulse_length_s", positive=True),
-        n_lines=t.int("n_lines"),
-        n_samples=t.int("n_samples"),
-        window_start_s=ws if ws is not None else 2.0 * r0 / C_LIGHT,
-        look_side=t.str("look_side", "right", ("right", "left")),
-    )
-    t.finish()
-    return r
+def _radar(where: str, data: Any) -> RadarConfig:
+    t = table(_RadarTable, data, where, positive=("carrier_frequency_hz", "prf_hz", "range_sampling_rate_hz",
+                                                  "pulse_length_s", "window_start_s", "first_range_m"),
+              at_least={"n_lines": 1, "n_samples": 1})
+    if (t.window_start_s is None) == (t.first_range_m is None):
+        raise ConfigError(f"{where}.window_start_s: give exactly one of window_start_s or first_range_m")
+    if t.chirp_rate_hz_per_s == 0:
+        raise ConfigError(f"{where}.chirp_rate_hz_per_s: must be non-zero (sign = chirp direction)")
+    return RadarConfig(
+        carrier_frequency_hz=t.carrier_frequency_hz, prf_hz=t.prf_hz, range_sampling_rate_hz=t.range_sampling_rate_hz,
+        chirp_rate_hz_per_s=t.chirp_rate_hz_per_s, pulse_length_s=t.pulse_length_s, n_lines=t.n_lines,
+        n_samples=t.n_samples,
+        window_start_s=t.window_start_s if t.window_start_s is not None else 2.0 * t.first_range_m / C_LIGHT,
+        look_side=t.look_side)
 
 
-def _antenna(t: _Table) -> AntennaConfig:
-    a = AntennaConfig(
-        length_m=t.num("length_m", positive=True),
-        height_m=t.num("height_m", positive=True),
-        look_angle_rad=math.radians(t.num("look_angle_deg")),
-        beam_extent=t.num("beam_extent", 1.0, positive=True),
-    )
-    if not 0.0 < a.look_angle_rad < math.pi / 2:
-        raise t.err("look_angle_deg", "must be in (0, 90) degrees")
-    t.finish()
-    return a
+def _antenna(where: str, data: Any) -> AntennaConfig:
+    t = table(_AntennaTable, data, where, positive=("length_m", "height_m", "beam_extent"))
+    if not 0.0 < t.look_angle_deg < 90.0:
+        raise ConfigError(f"{where}.look_angle_deg: must be in (0, 90) degrees, got {t.look_angle_deg!r}")
+    return AntennaConfig(length_m=t.length_m, height_m=t.height_m, look_angle_rad=math.radians(t.look_angle_deg),
+                         beam_extent=t.beam_extent)
 
 
-def _platform(t: _Table) -> OrbitPlatform | StateVectorPlatform | LinearPlatform:
-    kind = t.str("type", choices=PLATFORM_TYPES)
+def _platform(where: str, data: Any) -> OrbitPlatform | StateVectorPlatform | LinearPlatform:
+    kind = data.get("type") if isinstance(data, Mapping) else None
+    if kind is None:
+        raise ConfigError(f"{where}: missing required option(s) type (one of {', '.join(PLATFORM_TYPES)})")
+    if kind not in PLATFORM_TYPES:
+        raise ConfigError(f"{where}.type: {kind!r} is not one of {', '.join(PLATFORM_TYPES)}")
     if kind == "orbit":
-        e = t.num("eccentricity", nonneg=True)
-        if e >= 1:
-            raise t.err("eccentricity", "must be < 1 (closed orbit)")
-        p: Any = OrbitPlatform(Keplerian(
-            semi_major_axis_m=t.num("semi_major_axis_m", positive=True), eccentricity=e,
-            inclination_rad=math.radians(t.num("inclination_deg")),
-            raan_rad=math.radians(t.num("raan_deg")),
-            arg_perigee_rad=math.radians(t.num("arg_perigee_deg")),
-            mean_anomaly_rad=math.radians(t.num("mean_anomaly_deg"))))
-    elif kind == "state_vectors":
-        time = t.array("time_s")
-        p = StateVectorPlatform(t.str("frame", choices=("ECI", "ECEF")), time,
-                                t.array("position_m", (3,)), t.array("velocity_mps", (3,)))
-        if not (len(time) == len(p.position) == len(p.velocity)) or len(time) < 4:
-            raise t.err("time_s", "need >= 4 state vectors with as many positions and velocities")
+        o = table(_OrbitTable, data, where, positive=("semi_major_axis_m",), nonneg=("eccentricity",))
+        if o.eccentricity >= 1:
+            raise ConfigError(f"{where}.eccentricity: must be < 1 (closed orbit), got {o.eccentricity!r}")
+        return OrbitPlatform(Keplerian(
+            semi_major_axis_m=o.semi_major_axis_m, eccentricity=o.eccentricity,
+            inclination_rad=math.radians(o.inclination_deg), raan_rad=math.radians(o.raan_deg),
+            arg_perigee_rad=math.radians(o.arg_perigee_deg), mean_anomaly_rad=math.radians(o.mean_anomaly_deg)))
+    if kind == "state_vectors":
+        sv = table(_StateVectorTable, data, where)
+        time = np.asarray(sv.time_s, np.float64)
+        if not (len(time) == len(sv.position_m) == len(sv.velocity_mps)) or len(time) < 4:
+            raise ConfigError(f"{where}.time_s: need >= 4 state vectors with as many positions and velocities")
         if not np.all(np.diff(time) > 0):
-            raise t.err("time_s", "times must be strictly increasing")
-    else:
-        p = LinearPlatform(t.num("velocity_mps", positive=True), t.num("height_m", positive=True),
-                           t.num("x_m", 0.0), t.num("y_m", 0.0))
-    t.finish()
-    return p
+            raise ConfigError(f"{where}.time_s: times must be strictly increasing")
+        return StateVectorPlatform(sv.frame, time, np.asarray(sv.position_m, np.float64).reshape(-1, 3),
+                                   np.asarray(sv.velocity_mps, np.float64).reshape(-1, 3))
+    lin = table(_LinearTable, data, where, positive=("velocity_mps", "height_m"))
+    return LinearPlatform(lin.velocity_mps, lin.height_m, lin.x_m, lin.y_m)
 
 
-def _where(t: _Table, linear: bool) -> tuple:
-    """Position spec of a target or patch centre: geodetic, slant (range + azimuth time) or local."""
-    if linear:
-        if t.has("lat_deg") or t.has("slant_range_m"):
-            raise t.err("x_m", "a linear-platform scene places targets by x_m, y_m (z_m)")
-        return ("local", t.num("x_m"), t.num("y_m"), t.num("z_m", 0.0))
-    if t.has("x_m"):
-        raise t.err("x_m", "orbit scenes place targets by lat_deg/lon_deg or slant_range_m/azimuth_time_s")
-    if t.has("lat_deg"):
-        return ("geodetic", t.num("lat_deg"), t.num("lon_deg"), t.num("height_m", 0.0))
-    return ("slant", t.num("slant_range_m", positive=True), t.num("azimuth_time_s", 0.0),
-            t.num("height_m", 0.0))
+def _place_kind(where: str, data: Any, linear: bool) -> None:
+    """Refuse a position given in the other kind of scene's keys, saying which keys place it."""
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"{where} must be a table")
+    if linear and ("lat_deg" in data or "slant_range_m" in data):
+        raise ConfigError(f"{where}.x_m: a linear-platform scene places targets by x_m, y_m (z_m)")
+    if not linear and "x_m" in data:
+        raise ConfigError(f"{where}.x_m: orbit scenes place targets by lat_deg/lon_deg or slant_range_m/azimuth_time_s")
 
 
-def _target(t: _Table, linear: bool) -> PointTarget:
-    where = _where(t, linear)
-    amp = t.num("amplitude", 1.0, nonneg=True)
-    ph = math.radians(t.num("phase_deg", 0.0))
-    if linear:
-        vel = (t.num("vx_mps", 0.0), t.num("vy_mps", 0.0), 0.0)
-    else:
-        vel = (t.num("v_east_mps", 0.0), t.num("v_north_mps", 0.0), t.num("v_up_mps", 0.0))
-    t.finish()
-    return PointTarget(where, complex(amp * math.cos(ph), amp * math.sin(ph)), vel)
+def _where(where: str, p: _LocalPlace | _EarthPlace) -> tuple:
+    """Position spec of a target or patch centre: ('local', x, y, z), ('geodetic', lat, lon, h) or
+    ('slant', range, azimuth time, h)."""
+    if isinstance(p, _LocalPlace):
+        return ("local", p.x_m, p.y_m, p.z_m)
+    if p.lat_deg is not None or p.lon_deg is not None:
+        if p.lat_deg is None or p.lon_deg is None:
+            raise ConfigError(f"{where}: a geodetic position needs both lat_deg and lon_deg")
+        return ("geodetic", p.lat_deg, p.lon_deg, p.height_m)
+    if p.slant_range_m is None:
+        raise ConfigError(f"{where}: missing required option(s) slant_range_m (or lat_deg and lon_deg)")
+    return ("slant", p.slant_range_m, p.azimuth_time_s, p.height_m)
 
 
-def _clutter(t: _Table, linear: bool) -> ClutterPatch:
-    c = ClutterPatch(
-        where=_where(t, linear),
-        range_extent_m=t.num("range_extent_m", positive=True),
-        azimuth_extent_m=t.num("azimuth_extent_m", positive=True),
-        sigma0=10.0 ** (t.num("sigma0_db") / 10.0),
-        density_per_m2=t.num("density_per_m2", positive=True),
-    )
-    t.finish()
-    return c
+def _target(where: str, data: Any, linear: bool) -> PointTarget:
+    _place_kind(where, data, linear)
+    t = table(_LocalTarget if linear else _EarthTarget, data, where, positive=("slant_range_m",),
+              nonneg=("amplitude",))
+    amp, ph = t.amplitude, math.radians(t.phase_deg)
+    vel = (t.vx_mps, t.vy_mps, 0.0) if isinstance(t, _LocalTarget) else (t.v_east_mps, t.v_north_mps, t.v_up_mps)
+    return PointTarget(_where(where, t), complex(amp * math.cos(ph), amp * math.sin(ph)), vel)
+
+
+def _clutter(where: str, data: Any, linear: bool) -> ClutterPatch:
+    _place_kind(where, data, linear)
+    c = table(_LocalClutter if linear else _EarthClutter, data, where,
+              positive=("slant_range_m", "range_extent_m", "azimuth_extent_m", "density_per_m2"))
+    return ClutterPatch(where=_where(where, c), range_extent_m=c.range_extent_m, azimuth_extent_m=c.azimuth_extent_m,
+                        sigma0=10.0 ** (c.sigma0_db / 10.0), density_per_m2=c.density_per_m2)
+
+
+def _array_of_tables(doc: Mapping[str, Any], key: str, src: str) -> list:
+    v = doc.get(key, [])
+    if not isinstance(v, list):
+        raise ConfigError(f"{src}: {key} must be an array of tables ([[{key}]])")
+    return v
+
+
+def scene_from_mapping(doc: Mapping[str, Any], src: str = "<scene>", text: str = "") -> Scene:
+    """Validate a parsed scene file (``doc``: its TOML; ``src`` names it in messages; ``text``: its source,
+    kept in the product's truth)."""
+    from orbit.timeutil import parse_utc
+    from sarcli.sim.effects import known_effects, parse_effects  # registry; imported here to avoid a cycle
+
+    for key in ("scene", "radar", "antenna", "platform"):
+        if key not in doc:
+            raise ConfigError(f"{src}: missing table [{key}]")
+    known = {"scene", "radar", "antenna", "platform", "targets", "clutter", *known_effects()}
+    unknown = sorted(set(doc) - known)
+    if unknown:
+        raise ConfigError(f"{src}: unknown table(s) {', '.join(unknown)}; known: scene, radar, antenna, platform, "
+                          f"targets, clutter and the effect tables ({', '.join(known_effects())})")
+    st = table(_SceneTable, doc["scene"], f"{src}: scene", at_least={"seed": 0, "clutter_oversampling": 2})
+    try:
+        parse_utc(st.epoch_utc)
+    except ValueError as e:
+        raise ConfigError(f"{src}: scene.epoch_utc: {e}") from None
+    if len(set(st.effects)) != len(st.effects):
+        raise ConfigError(f"{src}: scene.effects: an effect is listed twice")
+    radar = _radar(f"{src}: radar", doc["radar"])
+    antenna = _antenna(f"{src}: antenna", doc["antenna"])
+    platform = _platform(f"{src}: platform", doc["platform"])
+    linear = isinstance(platform, LinearPlatform)
+    targets = [_target(f"{src}: targets[{i}]", x, linear) for i, x in enumerate(_array_of_tables(doc, "targets", src))]
+    clutter = [_clutter(f"{src}: clutter[{i}]", x, linear)
+               for i, x in enumerate(_array_of_tables(doc, "clutter", src))]
+    if not targets and not clutter:
+        raise ConfigError(f"{src}: the scene has no [[targets]] and no [[clutter]]")
+    params = parse_effects(list(st.effects), doc, platform, src)
+    return Scene(path=src, source_text=text, name=st.name if st.name is not None else Path(src).stem, seed=st.seed,
+                 epoch_utc=st.epoch_utc, center_time_s=st.center_time_s, effects=tuple(st.effects),
+                 effect_params=params, radar=radar, antenna=antenna, platform=platform, targets=targets,
+                 clutter=clutter, reference_height_m=st.reference_height_m, clutter_model=st.clutter_model,
+                 clutter_oversampling=st.clutter_oversampling)
 
 
 def parse_scene(text: str, src: str = "<scene>") -> Scene:
-    """Parse and validate scene TOML text (see the module docstring)."""
-    from sarcli.sim.effects import parse_effects  # registry; imported here to avoid a cycle
+    """Parse and validate scene TOML text."""
+    import tomllib
 
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ConfigError(f"{src}: not valid TOML ({e})") from None
-    root = _Table(doc, "", src)
-    for key in ("scene", "radar", "antenna", "platform"):
-        if key not in doc:
-            raise FormatError(f"{src}: missing table [{key}]")
-    st = root.sub("scene")
-    assert st is not None
-    seed = st.int("seed", minimum=0)
-    name = st.str("name", Path(src).stem)
-    epoch = st.str("epoch_utc", "2000-01-01T12:00:00Z")
-    from orbit.timeutil import parse_utc
-    try:
-        parse_utc(epoch)
-    except ValueError as e:
-        raise st.err("epoch_utc", str(e)) from None
-    center = st.num("center_time_s", 0.0)
-    ref_h = st.num("reference_height_m", 0.0)
-    clutter_model = st.str("clutter_model", "binned", ("binned", "exact"))
-    clutter_q = st.int("clutter_oversampling", 4, minimum=2)
-    st.used.add("effects")
-    effects = st.data.get("effects", [])
-    if not isinstance(effects, list) or not all(isinstance(x, str) for x in effects):
-        raise st.err("effects", "expected a list of effect names")
-    if len(set(effects)) != len(effects):
-        raise st.err("effects", "an effect is listed twice")
-    st.str("description", "")
-    st.finish()
-    radar = _radar(root.sub("radar"))  # type: ignore[arg-type]
-    antenna = _antenna(root.sub("antenna"))  # type: ignore[arg-type]
-    platform = _platform(root.sub("platform"))  # type: ignore[arg-type]
-    linear = isinstance(platform, LinearPlatform)
-    targets = [_target(_Table(x, f"targets.{i}", src), linear) for i, x in enumerate(_list(root, "targets"))]
-    clutter = [_clutter(_Table(x, f"clutter.{i}", src), linear) for i, x in enumerate(_list(root, "clutter"))]
-    if not targets and not clutter:
-        raise FormatError(f"{src}: the scene has no [[targets]] and no [[clutter]]")
-    params = parse_effects(effects, root, platform)
-    root.finish()
-    return Scene(path=src, source_text=text, name=name, seed=seed, epoch_utc=epoch, center_time_s=center,
-                 effects=tuple(effects), effect_params=params, radar=radar, antenna=antenna,
-                 platform=platform, targets=targets, clutter=clutter, reference_height_m=ref_h,
-                 clutter_model=clutter_model, clutter_oversampling=clutter_q)
-
-
-def _list(root: _Table, key: str) -> list:
-    root.used.add(key)
-    v = root.data.get(key, [])
-    if not isinstance(v, list):
-        raise FormatError(f"{root.src}: {key} must be an array of tables ([[{key}]])")
-    return v
+    return scene_from_mapping(doc, src, text)
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file; every problem is one :class:`FormatError` line."""
+    """Read and validate a scene file; every problem is one :class:`ConfigError` line."""
     p = Path(path)
     if not p.is_file():
-        raise FormatError(f"{p}: scene file not found")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise FormatError(f"{p}: cannot read scene file ({e.__class__.__name__})") from None
-    return parse_scene(text, str(p))
+        raise ConfigError(f"{p}: scene file not found")
+    doc = load_toml(p)
+    return scene_from_mapping(doc, str(p), p.read_text(encoding="utf-8"))

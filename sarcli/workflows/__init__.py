@@ -16,6 +16,11 @@ are registered in :data:`WORKFLOWS` by step name.
 from sarcli.registry import Registry
 
 WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
+    "ati_compensate": "sarcli.workflows.ati_compensate",
+    "ati_detect": "sarcli.workflows.ati_detect",
+    "ati_estimate": "sarcli.workflows.ati_estimate",
+    "ati_montecarlo": "sarcli.workflows.ati_montecarlo",
+    "design": "sarcli.workflows.design",
     "doppler": "sarcli.workflows.doppler",
     "gbsar_coherence": "sarcli.workflows.gbsar_coherence",
     "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
@@ -26,4 +31,12 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "gbsar_repeat": "sarcli.workflows.gbsar_repeat",
     "gbsar_scan": "sarcli.workflows.gbsar_scan",
     "gbsar_simulate": "sarcli.workflows.gbsar_simulate",
+    "info": "sarcli.workflows.info",
+    "ingest": "sarcli.workflows.ingest",
+    "optical_compare": "sarcli.workflows.optical_compare",
+    "orbit_accuracy": "sarcli.workflows.orbit_accuracy",
+    "orbit_info": "sarcli.workflows.orbit_info",
+    "orbit_interpolate": "sarcli.workflows.orbit_interpolate",
+    "run": "sarcli.workflows.run",
+    "simulate": "sarcli.workflows.simulate",
 })

@@ -160,13 +160,13 @@ def test_cli_human_output(cli):
 
 
 @pytest.mark.parametrize("text, msg", [
-    ("[design]\nplatform='boat'\ncarrier_frequency_hz=1e9\n", "platform must be one of"),
+    ("[design]\nplatform='boat'\ncarrier_frequency_hz=1e9\n", "d.toml: design.platform: 'boat' is not one of"),
     ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\n", "needs chirp_rate_hz_per_s"),
-    ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\nwings=2\n", "unknown design key"),
+    ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\nwings=2\n", "d.toml: design: unknown option(s) wings"),
     ("[design\n", "not valid TOML"),
-    ("[design]\nprf_hz=[1.0]\n", "platform is required"),
+    ("[design]\nprf_hz=[1.0]\n", "design: missing required option(s) platform"),
     ("[design]\nplatform='airborne'\ncarrier_frequency_hz=1e9\n[design.processor]\nlens=1\n",
-     "unknown [design.processor] key"),
+     "design.processor: unknown option(s) lens"),
     ("[radar]\n", "no [design] table"),
 ])
 def test_cli_bad_input_one_line(cli, tmp_path, text, msg):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
-from sarcli.io.ceos import aux as A
+from sarcli.io.ceos.radarsat1 import aux as A
 from sarcli.model.raw import Orbit, Radar, RawProduct
 
 C = 299_792_458.0

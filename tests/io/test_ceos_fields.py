@@ -8,9 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from sarcli.errors import FormatError
-from sarcli.io.ceos import aux as A
 from sarcli.io.ceos import fields as F
-from sarcli.io.ceos.samples import decode_lines, decode_reference, encode
+from sarcli.io.ceos.radarsat1 import aux as A
+from sarcli.io.ceos.radarsat1.samples import decode_lines, decode_reference, encode
 
 blocks = st.binary(min_size=50, max_size=50)
 
@@ -153,7 +153,7 @@ def test_record_header_roundtrip():
                 min_size=2, max_size=12).filter(lambda v: len(v) % 2 == 0),
        st.sampled_from([np.complex64, np.complex128]))
 def test_four_bit_check_matches_reference(vals, dtype):
-    from sarcli.io.ceos.samples import is_four_bit, is_four_bit_reference
+    from sarcli.io.ceos.radarsat1.samples import is_four_bit, is_four_bit_reference
 
     x = np.empty(len(vals) // 2, dtype)
     x.real, x.imag = vals[0::2], vals[1::2]

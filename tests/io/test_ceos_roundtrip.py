@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 from orbit.frames import eci_to_ecef
 from orbit.timeutil import parse_utc
 from sarcli.errors import FormatError
-from sarcli.io.ceos import CeosExportError, read_ceos, write_ceos
-from sarcli.io.ceos import aux as A
+from sarcli.io.ceos.radarsat1 import CeosExportError, read_ceos, write_ceos
+from sarcli.io.ceos.radarsat1 import aux as A
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import Orbit
 

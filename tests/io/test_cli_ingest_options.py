@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from sarcli.io.ceos import write_ceos
+from sarcli.io.ceos.radarsat1 import write_ceos
 
 from .test_ingest_cli import one_line_error
 

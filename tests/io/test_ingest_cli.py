@@ -10,7 +10,7 @@ import h5py
 import numpy as np
 import pytest
 
-from sarcli.io.ceos import write_ceos
+from sarcli.io.ceos.radarsat1 import write_ceos
 from sarcli.io.h5common import sha256_file
 from sarcli.io.raw import read_raw
 
@@ -74,7 +74,10 @@ def test_not_a_ceos_file(cli, scene, tmp_path):
     one_line_error(run_unchanged(cli, [lea, junk], "ingest", lea, junk, "-o", tmp_path / "o.h5"),
                    "not a CEOS data file")
     one_line_error(cli("ingest", dat, lea, "-o", tmp_path / "o.h5"), "leader and data swapped?")
-    one_line_error(cli("ingest", tmp_path, "-o", tmp_path / "o.h5"), "no LEA_01.001")
+    # a folder no reader recognises (sniffed: the readers are asked in turn); named, the CEOS reader says why
+    one_line_error(cli("ingest", tmp_path, "-o", tmp_path / "o.h5"), "no reader recognises this input",
+                   "ceos-rs1", "--format")
+    one_line_error(cli("ingest", tmp_path, "--format", "ceos-rs1", "-o", tmp_path / "o.h5"), "no LEA_01.001")
     empty = tmp_path / "empty.001"
     empty.write_bytes(b"")
     one_line_error(cli("ingest", lea, empty, "-o", tmp_path / "o.h5"), "empty file")

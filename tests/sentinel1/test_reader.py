@@ -125,13 +125,15 @@ def test_reader_plugin_and_cli_ingest(tmp_path, cli, s1_packets):
         np.testing.assert_array_equal(raw.auxiliary[name], direct.auxiliary[name])
 
 
-def test_cli_ingest_several_data_sets_needs_a_folder(tmp_path, cli):
+def test_cli_ingest_several_data_sets_one_product_each(tmp_path, cli):
+    """Several data sets: -o STEM.h5 gives STEM_NAME.h5 files, any other -o is a folder of NAME.h5
+    (the naming of docs/ingest.md)."""
     blob, _ = _stream([(4, {}), (4, {"swst": 5300})])
     (tmp_path / "x.dat").write_bytes(blob)
     r = cli("ingest", tmp_path / "x.dat", "-o", tmp_path / "one.h5")
-    assert r.exit_code != 0 and "2 data sets" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert r.exit_code == 0 and r.stderr.count("wrote") == 2, r.stderr
+    assert sorted(p.name for p in tmp_path.glob("one_*.h5")) == ["one_S3_VV_1.h5", "one_S3_VV_2.h5"]
     out = tmp_path / "all"
-    out.mkdir()
     assert cli("ingest", tmp_path / "x.dat", "-o", out).exit_code == 0
     assert sorted(p.name for p in out.iterdir()) == ["S3_VV_1.h5", "S3_VV_2.h5"]
 

@@ -1,12 +1,15 @@
-"""Radarsat-1 CEOS RAW: reader (``read_ceos``) and writer (``write_ceos``).
+"""CEOS SAR files: what every CEOS format shares, and the sensor-specific layouts built on it.
 
-Modules: ``fields`` (record header, ASCII/binary fields), ``aux`` (the 50-byte aux block and the timing
-it encodes), ``samples`` (4-bit I/Q decoding, numba + numpy reference), ``leader`` (leader records),
-``datafile`` (signal data file walking and records), ``reader``, ``writer``.
-Format facts and traps: ``docs/products.md`` (CEOS section) and the shared ``ceos-radarsat-raw.md``.
+Generic (any CEOS SAR product, "CEOS-SAR-CCT" family):
+
+- ``fields``: the 12-byte record header, record type codes, ASCII (``In``, ``Fw.d``, ...) and
+  big-endian binary fields, blank-padded writing;
+- ``records``: walking a file record by record (each header gives the record's length), the file
+  descriptor record that opens every file;
+- ``signal``: the signal data file: its descriptor's record count, the signal data records and
+  their 192-byte prefix (line number, acquisition date and time of day, chirp length).
+
+Sensor specifics live in sub-packages: ``radarsat1`` (the 50-byte aux block, 4-bit samples, leader
+values, beam table, reader ``read_ceos`` and writer ``write_ceos``). Format facts and traps:
+``docs/products.md`` (CEOS section) and ``docs/ingest.md``.
 """
-
-from sarcli.io.ceos.reader import MISSING_POLICIES, find_scene_files, read_ceos
-from sarcli.io.ceos.writer import CeosExportError, write_ceos
-
-__all__ = ["MISSING_POLICIES", "CeosExportError", "find_scene_files", "read_ceos", "write_ceos"]

@@ -1,18 +1,25 @@
 """Reader plug-in ``ceos-rs1``: Radarsat-1 CEOS RAW (a scene folder, or a leader and a data file).
 
-Decoding is in :mod:`sarcli.io.ceos`; this adapts it to the reader interface (:mod:`sarcli.io.readers`).
+Decoding is in :mod:`sarcli.io.ceos.radarsat1` (on the generic CEOS layer :mod:`sarcli.io.ceos`); this
+adapts it to the reader interface (:mod:`sarcli.io.readers`).
+
+Sniffing: two files of which one opens with a CEOS file descriptor record, or a folder holding a
+``LEA_01.001``/``DAT_01.001`` file (directly or in ``SCENE01``). A CEOS pair of another sensor is
+claimed too and then refused by the Radarsat-1 checks in one line (no other CEOS reader exists yet).
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 from sarcli.config import to_mapping
 from sarcli.errors import ConfigError
 from sarcli.io.readers import Ingested
+
+_log = logging.getLogger(__name__)
 
 F3_PULSES_KNOWN = (8, 9)  # the two published readings of beam F3's pulses in flight (ISCE, ASF MapReady)
 
@@ -24,11 +31,15 @@ class CeosOptions:
     f3_pulses: pulses in flight for beam F3 (9 per ASF MapReady, 8 per ISCE)."""
 
     keep_partial: bool = False
-    missing: Literal["zero", "repeat", "keep"] = "zero"
+    missing: str = "zero"
     max_gap: int = 200
     f3_pulses: int = 9
 
     def __post_init__(self) -> None:
+        from sarcli.io.ceos.radarsat1.reader import MISSING_POLICIES
+
+        if self.missing not in MISSING_POLICIES:
+            raise ConfigError(f"missing-line policy {self.missing!r} is not one of {', '.join(MISSING_POLICIES)}")
         if self.max_gap < 0:
             raise ConfigError(f"max_gap must be a number of lines >= 0, got {self.max_gap}")
         if self.f3_pulses not in F3_PULSES_KNOWN:
@@ -36,12 +47,20 @@ class CeosOptions:
                               f"beam F3 per ISCE or ASF MapReady), got {self.f3_pulses}")
 
 
-def _leader_signature(path: Path) -> bool:
-    from sarcli.io.ceos.fields import CODES_FILE_DESCRIPTOR
+def _starts_with_file_descriptor(path: Path) -> bool:
+    from sarcli.io.ceos.records import has_file_descriptor
 
     with open(path, "rb") as f:
-        head = f.read(8)
-    return len(head) == 8 and tuple(head[4:8]) == CODES_FILE_DESCRIPTOR
+        return has_file_descriptor(f.read(8))
+
+
+def _scene_folder_names(folder: Path) -> bool:
+    """A CEOS scene folder: it (or its SCENE01) holds a file named like a RAW leader or data file."""
+    names = {"lea_01.001", "dat_01.001"}
+    for sub in (folder, folder / "SCENE01", folder / "scene01"):
+        if sub.is_dir() and any(p.name.lower() in names for p in sub.iterdir()):
+            return True
+    return False
 
 
 class CeosRs1Reader:
@@ -50,17 +69,18 @@ class CeosRs1Reader:
     Options = CeosOptions
 
     def sniff(self, sources: Sequence[Path]) -> bool:
-        from sarcli.io.ceos import find_scene_files
+        from sarcli.io.ceos.radarsat1 import find_scene_files
 
-        if len(sources) not in (1, 2):
-            return False
-        if len(sources) == 1 and not Path(sources[0]).is_dir():
-            return False
-        lea, _ = find_scene_files(*sources)
-        return _leader_signature(lea)
+        paths = [Path(s) for s in sources]
+        if len(paths) == 2 and all(p.is_file() for p in paths):
+            return any(_starts_with_file_descriptor(p) for p in paths)
+        if len(paths) == 1 and paths[0].is_dir() and _scene_folder_names(paths[0]):
+            find_scene_files(paths[0])  # an incomplete scene folder: the one-line reason
+            return True
+        return False
 
     def read(self, sources: Sequence[Path], options: CeosOptions) -> Ingested:
-        from sarcli.io.ceos import find_scene_files, read_ceos
+        from sarcli.io.ceos.radarsat1 import find_scene_files, read_ceos
 
         if len(sources) not in (1, 2):
             raise ConfigError("give a CEOS scene folder, or its leader and data files")
@@ -75,7 +95,12 @@ class CeosRs1Reader:
         if x["ceos_missing_lines"]:
             notes.append(f"{x['ceos_missing_lines']} missing lines in {len(x['ceos_gaps'])} gap(s): "
                          f"policy {options.missing}")
-        return Ingested({"": raw}, (lea, dat), {"format": self.name, **to_mapping(options)}, notes)
+        _log.debug("%s: beam %s, %d lines x %d samples, %d records of %d declared", dat, x["ceos_beam_name"],
+                   *raw.shape, x["ceos_records_read"], x["ceos_records_declared"])
+        summary = {"beam": x["ceos_beam_name"], "missing_lines": x["ceos_missing_lines"],
+                   "missing_policy": x["ceos_missing_policy"], "truncated": x["ceos_truncated"],
+                   "replica_lines": len(x["ceos_replica_lines"])}
+        return Ingested({"": raw}, (lea, dat), {"format": self.name, **to_mapping(options)}, notes, {"": summary})
 
 
 READER = CeosRs1Reader()

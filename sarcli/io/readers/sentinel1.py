@@ -56,7 +56,10 @@ class Sentinel1Reader:
     def sniff(self, sources: Sequence[Path]) -> bool:
         if len(sources) != 1:
             return False
-        files = _measurement_files(Path(sources[0])) if Path(sources[0]).is_dir() else [Path(sources[0])]
+        source = Path(sources[0])
+        if source.is_dir() and not source.name.upper().endswith(".SAFE") and not any(source.rglob("*.dat")):
+            return False  # a folder of another format (a .SAFE folder without measurement files: the reason)
+        files = _measurement_files(source) if source.is_dir() else [source]
         return all(p.is_file() and looks_like_packets(p) for p in files)
 
     def read(self, sources: Sequence[Path], options: Sentinel1Options) -> Ingested:

@@ -3,8 +3,11 @@
 An effect module defines:
 
 - ``NAME`` (the name used in ``scene.effects``) and ``DOC`` (one line),
-- ``parse(table, platform) -> params`` validating its optional top-level scene table ``[NAME]``
-  (``table`` is ``None`` when absent); raise ``FormatError`` for bad values or an unsuitable platform,
+- optionally ``Options``: a frozen dataclass of the keys of its top-level scene table ``[NAME]``, parsed
+  with :func:`sarcli.config.from_mapping` (unknown keys, wrong types and non-finite numbers are refused
+  there); an effect without ``Options`` takes no table,
+- ``parse(options, platform) -> params``: the checks that need several keys or the platform (``options``
+  is ``None`` when the table is absent); raise ``ConfigError("NAME.key: ...")`` (the file name is added),
 - optionally ``configure(ctx, params)``: switch physics on in the :class:`SimContext` before echoes,
 - optionally ``apply(ctx, params, product)`` with an integer ``ORDER``: post-process the product
   (lower ORDER first: replica 10, noise 20, quantization 30).
@@ -16,11 +19,12 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from collections.abc import Mapping
 from functools import lru_cache
 from types import ModuleType
 from typing import Any
 
-from sarcli.errors import FormatError
+from sarcli.errors import ConfigError
 
 
 @lru_cache(maxsize=1)
@@ -33,8 +37,8 @@ def registry() -> dict[str, ModuleType]:
     return out
 
 
-def no_parameters(table: Any, platform: Any) -> None:
-    """``parse`` of an effect without parameters (its table, if any, must be empty)."""
+def no_parameters(options: Any, platform: Any) -> None:
+    """``parse`` of an effect without parameters."""
     return None
 
 
@@ -49,23 +53,31 @@ def known_effects() -> list[str]:
     return sorted(registry())
 
 
-def parse_effects(names: list[str], root: Any, platform: Any) -> dict[str, Any]:
-    """Validate the listed effect names and parse each one's parameter table."""
+def parse_effects(names: list[str], doc: Mapping[str, Any], platform: Any, src: str) -> dict[str, Any]:
+    """Validate the listed effect names and parse each one's parameter table (``doc``: the scene file's
+    TOML, ``src`` its name for messages)."""
+    from sarcli.sim.scene import table as parse_table
+
     reg = registry()
     params: dict[str, Any] = {}
-    for name in reg:
-        if name in root.data:
-            root.used.add(name)
     for name in names:
         if name not in reg:
-            raise FormatError(f"{root.src}: unknown effect {name!r}; known effects: {', '.join(known_effects())}")
-        table = root.sub(name) if name in root.data else None
+            raise ConfigError(f"{src}: unknown effect {name!r}; known effects: {', '.join(known_effects())}")
+        mod = reg[name]
+        options_cls = getattr(mod, "Options", None)
+        data = doc.get(name)
+        options = None
+        if data is not None:
+            if options_cls is None:
+                keys = ", ".join(data) if isinstance(data, Mapping) else repr(data)
+                if not isinstance(data, Mapping) or data:
+                    raise ConfigError(f"{src}: {name}: effect {name} takes no options, got {keys}")
+            else:
+                options = parse_table(options_cls, data, f"{src}: {name}")
         try:
-            params[name] = reg[name].parse(table, platform)
-        except FormatError as e:
-            raise e if str(e).startswith(root.src) else FormatError(f"{root.src}: {e}") from None
-        if table is not None:
-            table.finish()
+            params[name] = mod.parse(options, platform)
+        except ConfigError as e:
+            raise e if str(e).startswith(src) else ConfigError(f"{src}: {e}") from None
     return params
 
 

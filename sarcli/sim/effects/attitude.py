@@ -5,15 +5,23 @@ R = Rz(yaw) Ry(pitch). Roll is part of the antenna look angle ([antenna] look_an
 """
 
 import math
+from dataclasses import dataclass
 
 NAME = "attitude"
 DOC = "pitch/yaw pointing of the beam (moves the Doppler centroid)"
 
 
-def parse(table, platform):
-    if table is None:
-        return (0.0, 0.0)
-    return (math.radians(table.num("pitch_deg", 0.0)), math.radians(table.num("yaw_deg", 0.0)))
+@dataclass(frozen=True)
+class Options:
+    """pitch_deg, yaw_deg: platform pitch and yaw (degrees)."""
+
+    pitch_deg: float = 0.0
+    yaw_deg: float = 0.0
+
+
+def parse(options, platform):
+    o = options or Options()
+    return (math.radians(o.pitch_deg), math.radians(o.yaw_deg))
 
 
 def configure(ctx, params):

@@ -6,21 +6,33 @@ sample, the same in every channel. Alternatively ``noise_power`` sets P_noise ab
 The noise power used is recorded in /truth/noise_power.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from sarcli.errors import FormatError
+from sarcli.errors import ConfigError, FormatError
 
 NAME = "noise"
 DOC = "thermal noise at snr_db (raw SNR of the illuminated samples) or at noise_power"
 ORDER = 20
 
 
-def parse(table, platform):
-    if table is None or (table.has("snr_db") == table.has("noise_power")):
-        raise FormatError("effect noise needs a table [noise] with exactly one of snr_db or noise_power")
-    if table.has("snr_db"):
-        return ("snr_db", table.num("snr_db"))
-    return ("noise_power", table.num("noise_power", positive=True))
+@dataclass(frozen=True)
+class Options:
+    """snr_db: raw SNR of the illuminated samples (dB); noise_power: E|n|^2 per complex sample. One of them."""
+
+    snr_db: float | None = None
+    noise_power: float | None = None
+
+
+def parse(options, platform):
+    if options is None or ((options.snr_db is None) == (options.noise_power is None)):
+        raise ConfigError("effect noise needs a table [noise] with exactly one of snr_db or noise_power")
+    if options.snr_db is not None:
+        return ("snr_db", options.snr_db)
+    if not options.noise_power > 0:
+        raise ConfigError(f"noise.noise_power: must be > 0, got {options.noise_power!r}")
+    return ("noise_power", options.noise_power)
 
 
 def noise_power(echo: np.ndarray, params) -> float:

@@ -12,20 +12,34 @@ per scene so that the median lit line needs ``agc_center_db`` (default 10 dB) of
 quantizer) sets the loading. The replica, if stored, is quantized at the same loading.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from sarcli.errors import ConfigError
 
 NAME = "quantization"
 DOC = "n-bit I/Q quantization with integer-dB AGC per line (4-bit odd levels like Radarsat-1)"
 ORDER = 30
 
 
-def parse(table, platform):
-    bits = table.int("bits", 4, minimum=2) if table is not None else 4
-    if bits > 8:
-        raise table.err("bits", "at most 8 bits")
-    rms = table.num("target_rms", 0.373 * 2**bits, positive=True) if table is not None else 0.373 * 2**bits
-    center = table.num("agc_center_db", 10.0) if table is not None else 10.0
-    return bits, rms, center
+@dataclass(frozen=True)
+class Options:
+    """bits: 2..8; target_rms: loading per component (default 0.373 * 2^bits); agc_center_db: AGC of the
+    median lit line (dB)."""
+
+    bits: int = 4
+    target_rms: float | None = None
+    agc_center_db: float = 10.0
+
+
+def parse(options, platform):
+    o = options or Options()
+    if not 2 <= o.bits <= 8:
+        raise ConfigError(f"quantization.bits: must be 2..8, got {o.bits}")
+    if o.target_rms is not None and not o.target_rms > 0:
+        raise ConfigError(f"quantization.target_rms: must be > 0, got {o.target_rms!r}")
+    return o.bits, (0.373 * 2**o.bits if o.target_rms is None else o.target_rms), o.agc_center_db
 
 
 def quantize(u: np.ndarray, bits: int) -> np.ndarray:

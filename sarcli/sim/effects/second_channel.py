@@ -6,19 +6,27 @@ both channels share the transmitter's antenna gain. Stored in /echo_channels wit
 radar.receiver_offsets_m = (0, d).
 """
 
-from sarcli.errors import FormatError
+from dataclasses import dataclass
+
+from sarcli.errors import ConfigError
 
 NAME = "second_channel"
 DOC = "second receiver d metres along track, bistatic (R_tx + R_rx)/2 per channel"
 
 
-def parse(table, platform):
-    if table is None:
-        raise FormatError("effect second_channel needs a table [second_channel] with receiver_offset_m")
-    d = table.num("receiver_offset_m")
-    if d == 0:
-        raise table.err("receiver_offset_m", "must be non-zero")
-    return d
+@dataclass(frozen=True)
+class Options:
+    """receiver_offset_m: along-track position of receiver 1 relative to the transmitter (m), non-zero."""
+
+    receiver_offset_m: float
+
+
+def parse(options, platform):
+    if options is None:
+        raise ConfigError("effect second_channel needs a table [second_channel] with receiver_offset_m")
+    if options.receiver_offset_m == 0:
+        raise ConfigError("second_channel.receiver_offset_m: must be non-zero")
+    return options.receiver_offset_m
 
 
 def configure(ctx, params):

@@ -1,4 +1,4 @@
-"""Radarsat-1 RAW leader file: file descriptor (720 B), data set summary (4096 B), platform position
+"""Radarsat-1 RAW leader values: the leader file's file descriptor (720 B), data set summary (4096 B), platform position
 (8960 B) [S Table 4, B-6, B-7, B-13]. Decoding and encoding of the fields sarcli uses.
 
 A RAW leader has no PRF, sampling rate, range gate or Doppler (those come from each line's aux block).
@@ -20,6 +20,7 @@ import numpy as np
 
 from sarcli.errors import FormatError
 from sarcli.io.ceos import fields as F
+from sarcli.io.ceos.records import file_descriptor, walk
 
 FILE_DESCRIPTOR_BYTES = 720
 DSS_BYTES = 4096
@@ -111,31 +112,23 @@ def _parse_platform(rec: bytes, src: str) -> StateVectorRecord:
 
 
 def parse_leader(buf: bytes, src: str) -> LeaderInfo:
-    """Walk the leader's records by their headers and decode the data set summary and state vectors."""
-    if len(buf) < F.HEADER_BYTES:
-        raise FormatError(f"{src}: not a CEOS leader file (only {len(buf)} bytes)")
-    first = F.parse_header(buf, 0)
-    if first.codes == F.CODES_FILE_DESCRIPTOR and first.length != FILE_DESCRIPTOR_BYTES:
-        raise FormatError(f"{src}: not a CEOS leader file (its file descriptor is {first.length} bytes, a "
-                          f"leader's is {FILE_DESCRIPTOR_BYTES}; leader and data swapped?)")
-    if first.codes != F.CODES_FILE_DESCRIPTOR or first.length != FILE_DESCRIPTOR_BYTES \
-            or F.ascii_field(buf, 17, 28) != "CEOS-SAR-CCT":
-        raise FormatError(f"{src}: not a CEOS leader file (no CEOS-SAR-CCT file descriptor record)")
+    """Walk the leader's records (``sarcli.io.ceos.records.walk``) and decode the data set summary and
+    the state vectors."""
+    if len(buf) >= F.HEADER_BYTES:
+        first = F.parse_header(buf, 0)
+        if first.codes == F.CODES_FILE_DESCRIPTOR and first.length != FILE_DESCRIPTOR_BYTES:
+            raise FormatError(f"{src}: not a CEOS leader file (its file descriptor is {first.length} bytes, a "
+                              f"leader's is {FILE_DESCRIPTOR_BYTES}; leader and data swapped?)")
+    file_descriptor(buf, src, "CEOS leader file", min_length=FILE_DESCRIPTOR_BYTES)
     dss = platform = None
-    off = 0
-    while off < len(buf):
-        if off + F.HEADER_BYTES > len(buf):
-            raise FormatError(f"{src}: truncated record header at byte {off}")
+    w = walk(buf, src)
+    for off, length in zip(w.offsets.tolist(), w.lengths.tolist(), strict=True):
         h = F.parse_header(buf, off)
-        if h.length < F.HEADER_BYTES or off + h.length > len(buf):
-            raise FormatError(f"{src}: record {h.sequence} at byte {off} claims {h.length} bytes; "
-                              f"only {len(buf) - off} remain (truncated or corrupt)")
-        rec = bytes(buf[off:off + h.length])
+        rec = bytes(buf[off:off + length])
         if h.codes == F.CODES_DATA_SET_SUMMARY:
             dss = _parse_dss(rec, src)
         elif h.codes == F.CODES_PLATFORM_POSITION:
             platform = _parse_platform(rec, src)
-        off += h.length
     if dss is None:
         raise FormatError(f"{src}: no data set summary record in the leader")
     if platform is None:

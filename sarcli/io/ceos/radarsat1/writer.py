@@ -40,11 +40,12 @@ from orbit.frames import ecef_to_eci, gmst
 from orbit.timeutil import parse_utc
 from sarcli import __version__
 from sarcli.errors import SarcliError
-from sarcli.io.ceos import aux as A
 from sarcli.io.ceos import fields as F
-from sarcli.io.ceos.datafile import ECHO_START, build_descriptor, build_prefix
-from sarcli.io.ceos.leader import LeaderInfo, StateVectorRecord, build_leader
-from sarcli.io.ceos.samples import encode, is_four_bit, quantize_replica
+from sarcli.io.ceos.radarsat1 import aux as A
+from sarcli.io.ceos.radarsat1.datafile import ECHO_START, build_descriptor
+from sarcli.io.ceos.radarsat1.leader import LeaderInfo, StateVectorRecord, build_leader
+from sarcli.io.ceos.radarsat1.samples import encode, is_four_bit, quantize_replica
+from sarcli.io.ceos.signal import build_prefix
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import RawProduct
 

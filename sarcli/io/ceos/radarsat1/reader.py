@@ -39,10 +39,10 @@ import numpy as np
 from orbit.frames import gmst
 from orbit.timeutil import format_utc
 from sarcli.errors import FormatError
-from sarcli.io.ceos import aux as A
-from sarcli.io.ceos.datafile import ECHO_START, index_records
-from sarcli.io.ceos.leader import parse_leader
-from sarcli.io.ceos.samples import decode_lines, decode_reference
+from sarcli.io.ceos.radarsat1 import aux as A
+from sarcli.io.ceos.radarsat1.datafile import ECHO_START, index_records
+from sarcli.io.ceos.radarsat1.leader import parse_leader
+from sarcli.io.ceos.radarsat1.samples import decode_lines, decode_reference
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import Orbit, Radar, RawProduct
 
