@@ -23,7 +23,14 @@ def ingest(
                                      help="A reader option (repeatable), e.g. --option missing=repeat."),
     matlab: Path = typer.Option(None, "--matlab", help="Cumming & Wong MATLAB raw block (.mat): --format matlab-cw."),
     params: Path = typer.Option(None, "--params", help="Run-parameter .mat file that goes with --matlab."),
-    epoch: str = typer.Option(None, "--epoch", help="MATLAB only: ISO-8601 UTC time of the first line."),
+    epoch: str = typer.Option(None, "--epoch", help="MATLAB only: ISO-8601 UTC time of line 1 of the pass."),
+    agc: Path = typer.Option(None, "--agc", help="MATLAB only: the pass's AGC table (AGC_attenuation_values.mat); "
+                                                 "its attenuation is stored per line and undone by the processing."),
+    first_line: str = typer.Option(None, "--first-line", metavar="N|auto",
+                                   help="MATLAB only: the block's first line in the pass (1-based; default: the "
+                                        "params file's first_rg_line; auto: found from the line power vs --agc)."),
+    first_cell: int = typer.Option(None, "--first-cell",
+                                   help="MATLAB only: the block's first range cell (1-based; default: first_rg_cell)."),
     keep_partial: bool = typer.Option(False, "--keep-partial",
                                       help="CEOS: keep the complete lines of a truncated data file; Sentinel-1: "
                                            "drop a trailing partial packet."),
@@ -44,7 +51,9 @@ def ingest(
     file or a .SAFE folder), and any installed plug-in. Several data sets in one input (swaths,
     polarizations): one product each, in the folder -o, or STEM_NAME.h5 for -o STEM.h5. Reader
     options: --option KEY=VALUE; --keep-partial (CEOS, Sentinel-1), --missing, --max-gap, --f3-pulses
-    (CEOS) and --epoch (MATLAB) are shortcuts.
+    (CEOS) and --epoch, --agc, --first-line, --first-cell (MATLAB) are shortcuts. A MATLAB block is placed
+    in its pass (azimuth time from the start line, near range from the start cell); with --agc the
+    start line is checked against the table (a contradicted one is refused, naming the line that fits).
     Nothing is written to the inputs. CEOS: missing lines are found from the aux-block clock against
     the PRF and handled by --missing (reported); a truncated data file is refused unless --keep-partial.
 
@@ -57,6 +66,12 @@ def ingest(
       sarcli ingest rs1_vancouver_block1.mat rs1_vancouver_run_params.mat -o van.h5 --epoch 2002-06-16T14:50:00Z
 
       sarcli ingest --matlab rs1_vancouver_block1.mat --params rs1_vancouver_run_params.mat -o van.h5
+
+      sarcli ingest --matlab squamish_garibaldi.mat --params squamish_garibaldi_run_params.mat
+      --agc AGC_attenuation_values.mat -o squamish.h5
+
+      sarcli ingest --matlab rs1_vancouver_block1.mat --params rs1_vancouver_run_params.mat
+      --agc AGC_attenuation_values.mat --first-line auto --first-cell 1050 -o van.h5
 
       sarcli ingest demo/ceos --format ceos-rs1 --option max_gap=50 -o raw.h5 --json
 
@@ -74,8 +89,13 @@ def ingest(
     elif params is not None:
         raise ConfigError("--params goes with --matlab DATA.mat")
     options = parse_option_values(option or [])
+    if first_line is not None and first_line != "auto":
+        if not first_line.isdigit():
+            raise ConfigError(f"--first-line must be a line number or auto, got {first_line!r}")
+        first_line = int(first_line)
     sugar = {"keep_partial": keep_partial or None, "missing": missing, "max_gap": max_gap, "f3_pulses": f3_pulses,
-             "epoch": epoch}
+             "epoch": epoch, "agc": None if agc is None else str(agc), "first_line": first_line,
+             "first_cell": first_cell}
     for key, value in sugar.items():
         if value is not None:
             if key in options:

@@ -1,7 +1,8 @@
 """Reader plug-in ``matlab-cw``: a Cumming & Wong MATLAB raw block and its run-parameter file.
 
 Decoding is in :mod:`sarcli.io.matlab`; this adapts it to the reader interface (:mod:`sarcli.io.readers`).
-Sources: ``DATA.mat PARAMS.mat`` (or ``--matlab DATA.mat --params PARAMS.mat`` on the command line).
+Sources: ``DATA.mat PARAMS.mat`` (or ``--matlab DATA.mat --params PARAMS.mat`` on the command line);
+the pass's AGC table is an option (``agc``, ``--agc TABLE.mat``).
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 from sarcli.config import to_mapping
 from sarcli.errors import ConfigError
@@ -17,11 +19,17 @@ from sarcli.io.readers import Ingested
 
 @dataclass(frozen=True)
 class MatlabOptions:
-    """epoch: ISO-8601 UTC time of the first line (a block carries none); variable: the array's name in
-    the data file (default ``data``, or the only variable)."""
+    """epoch: ISO-8601 UTC time of line 1 of the pass (a block carries none); variable: the array's name
+    in the data file (default ``data``, or the only variable); agc: the pass's receiver-attenuation
+    table (MAT file, ``nom_attenuation`` dB per line); first_line: the block's first line in the pass
+    (1-based; default the parameter file's ``first_rg_line``; ``"auto"``: found from the line power
+    against ``agc``); first_cell: its first range cell (1-based; default ``first_rg_cell``)."""
 
     epoch: str | None = None
     variable: str | None = None
+    agc: Path | None = None
+    first_line: int | Literal["auto"] | None = None
+    first_cell: int | None = None
 
 
 def _is_mat(path: Path) -> bool:
@@ -29,9 +37,26 @@ def _is_mat(path: Path) -> bool:
         return f.read(10).startswith(b"MATLAB 5.0")
 
 
+def _notes(attrs: dict, n_lines: int) -> list[str]:
+    """What the user must know about the placement and the attenuation (one line each)."""
+    line, cell = attrs["pass_first_line"], attrs["pass_first_cell"]
+    notes = [f"block placed at line {line} ({attrs['placement_lines_source']}) and cell {cell} "
+             f"({attrs['placement_cells_source']}) of the pass"]
+    if "agc_start_check" in attrs:
+        check = attrs["agc_start_check"]
+        z = attrs["agc_start_z"]
+        if check == "confirmed":
+            notes.append(f"AGC table applied to lines {line}-{line + n_lines - 1}: the line power steps where the table "
+                         f"does (z = {z:.1f}, next best start {attrs['agc_next_best_z']:.1f})")
+        else:
+            notes.append(f"AGC table applied to lines {line}-{line + n_lines - 1}; the line power cannot confirm the "
+                         f"start line (z = {z:.1f}, best {attrs['agc_best_z']:.1f} at line {attrs['agc_best_line']})")
+    return notes
+
+
 class MatlabCwReader:
     name = "matlab-cw"
-    description = "Cumming & Wong MATLAB raw block: DATA.mat PARAMS.mat"
+    description = "Cumming & Wong MATLAB raw block: DATA.mat PARAMS.mat (option agc: the pass's AGC table)"
     Options = MatlabOptions
 
     def sniff(self, sources: Sequence[Path]) -> bool:
@@ -43,8 +68,14 @@ class MatlabCwReader:
         if len(sources) != 2:
             raise ConfigError("a MATLAB block needs two files: DATA.mat PARAMS.mat")
         data, params = (Path(s) for s in sources)
-        raw = read_matlab_block(data, params, variable=options.variable, epoch_utc=options.epoch)
-        return Ingested({"": raw}, (data, params), {"format": self.name, **to_mapping(options)})
+        raw = read_matlab_block(data, params, variable=options.variable, epoch_utc=options.epoch,
+                                agc_path=options.agc, first_line=options.first_line, first_cell=options.first_cell)
+        inputs = (data, params) + (() if options.agc is None else (Path(options.agc),))
+        a = raw.extra_attrs
+        summary = {k: a[k] for k in ("pass_first_line", "pass_first_cell", "agc_start_check", "agc_start_z",
+                                     "agc_best_line", "agc_output_db_per_input_db") if k in a}
+        return Ingested({"": raw}, inputs, {"format": self.name, **to_mapping(options)},
+                        _notes(a, raw.shape[0]), {"": summary})
 
 
 READER = MatlabCwReader()
