@@ -25,6 +25,9 @@ Layout (all SI; see ``docs/products.md``)::
     /attitude              optional group: time (s), pitch, roll, yaw (rad, float64)
     /truth                 optional group, simulated products only: scene_toml (attr), targets
                            (compound table), and any truth arrays (e.g. doppler_centroid_hz)
+    /calibration           optional group: lines that are not echoes (e.g. NISAR calType != 0), never
+                           focused: echo (n_cal, n_channels, n_samples), line (their zeroed slots in
+                           /echo), azimuth_time, reader-specific labels
 
 Frames: "ECI" inertial of date (X to the equinox, Z spin axis; GMST rotation to ECEF, see
 ``orbit.frames``), "ECEF" WGS-84 Earth-fixed, "LOCAL" a flat-Earth Cartesian frame for airborne
@@ -132,6 +135,8 @@ def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = 
         write_platform(f, p.orbit, p.attitude)
         if p.truth is not None:
             write_mapping(f, "truth", p.truth)
+        if p.calibration is not None:
+            write_mapping(f, "calibration", p.calibration)
 
 
 def write_radar(f: h5py.Group, radar: Radar) -> h5py.Group:
@@ -218,6 +223,7 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
             agc_db=g["agc_db"][()] if "agc_db" in g else None,
             replica=g["replica"][()] if "replica" in g else None,
             orbit=orbit, attitude=attitude, truth=truth,
+            calibration=read_mapping(f["calibration"]) if "calibration" in f else None,
         )
         standard = set(PROVENANCE_ATTRS) | {"epoch_utc", "look_side", "source", "n_channels"}
         p.extra_attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()

@@ -67,6 +67,7 @@ def _check(name: str, obj: Any) -> None:
 READERS: Registry[SensorReader] = Registry("sensor reader", "sarcli.readers", {
     "ceos-rs1": "sarcli.io.readers.ceos_rs1:READER",
     "matlab-cw": "sarcli.io.readers.matlab_cw:READER",
+    "nisar-l0b": "sarcli.io.readers.nisar_l0b:READER",
 }, check=_check)
 
 
