@@ -78,7 +78,7 @@ class Analysis:
         return asdict(self)
 
 
-def analyse(slc: SLC, reflectors: list[CornerReflector], search: int = 5, wet_zenith_m: float = 0.15,
+def analyse(slc: SLC, reflectors: list[CornerReflector], search: int = 8, wet_zenith_m: float = 0.15,
             need: int = 0) -> Analysis:
     """The corner-reflector analysis of ``slc`` (module docstring). ``need``: validity flags required."""
     from orbit.timeutil import add_seconds

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from sarcli.errors import ConfigError
-from sarcli.workflows.base import Progress, Provenance, Report, using
+from sarcli.workflows.base import Progress, Provenance, Report, refuse_overwriting_inputs, using
 
 VALIDITY_NEEDED = {"any": 0, "ipr": 1, "radiometry": 2, "geometry": 4}
 
@@ -36,7 +36,7 @@ class Config:
     plots: Path | None = None
     frequency: str | None = None
     polarization: str | None = None
-    search_px: int = 5
+    search_px: int = 8
     wet_zenith_delay_m: float = 0.15
     validity: Literal["any", "ipr", "radiometry", "geometry"] = "any"
 
@@ -118,15 +118,16 @@ def run(config: Config, provenance: Provenance | None = None,
         raise ConfigError(f"plot folder {config.plots} does not exist: create it first")
     with using(provenance):
         reflectors = parse_reflectors(config.reflectors)
+        if config.plots is not None:  # every picture the CSV could give, checked before any work
+            refuse_overwriting_inputs([config.slc, config.reflectors],
+                                      sorted({Path(config.plots) / _plot_name(r.id) for r in reflectors}))
         slc = read_image(config.slc, config.frequency, config.polarization)
         res = analyse(slc, reflectors, config.search_px, config.wet_zenith_delay_m, VALIDITY_NEEDED[config.validity])
         plots = []
         if config.plots is not None:
             from sarcli.calibration.plots import plot_reflector
-            from sarcli.workflows.base import refuse_overwriting_inputs
 
             names = [Path(config.plots) / _plot_name(r.id) for r in res.results]
-            refuse_overwriting_inputs([config.slc, config.reflectors], names)
             dr = float(slc.slant_range[1] - slc.slant_range[0])
             for i, (r, name) in enumerate(zip(res.results, names, strict=True)):
                 plot_reflector(name, slc.image, r, dr, title=f"{Path(config.slc).name}: corner reflector {r.id}")

@@ -112,7 +112,8 @@ class NisarRslcFormat:
         from sarcli.io.nisar.rslc import write_rslc
 
         meta = self.meta(slc, options, tuple(Path(i).name for i in inputs))
-        write_rslc(output, {options.polarization: slc}, meta, inputs=inputs, compression=options.compression)
+        write_rslc(output, {options.polarization: slc}, meta, inputs=inputs, compression=options.compression,
+                   parameters={"export": {"format": self.name, "options": to_mapping(options)}})
         return {"polarization": options.polarization, "frequency": options.frequency,
                 "processed_range_bandwidth_hz": meta.processed_range_bandwidth_hz,
                 "processed_azimuth_bandwidth_hz": meta.processed_azimuth_bandwidth_hz}

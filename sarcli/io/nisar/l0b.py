@@ -91,7 +91,7 @@ def sniff_l0b(path: str | os.PathLike) -> bool:
     try:
         with h5py.File(path, "r") as f:
             return any(isinstance(f.get(f"science/{b}/RRSD"), h5py.Group) for b in ("LSAR", "SSAR"))
-    except OSError:
+    except (OSError, RuntimeError, KeyError, ValueError):  # h5py on a damaged file: not sniffable
         return False
 
 
@@ -449,6 +449,9 @@ def read_l0b(path: str | os.PathLike, frequencies: tuple[str, ...] = (),
         if not found_freqs:
             raise FormatError(f"{path}: incomplete NISAR L0B: {swaths.name} has no frequency{{A,B}} group")
         if not grids:
+            if not (frequencies or polarizations):
+                raise FormatError(f"{path}: incomplete NISAR L0B: no tx{{H,V,L,R}} group with echo data under "
+                                  f"{swaths.name}")
             want = ", ".join([*frequencies, *polarizations])
             raise ConfigError(f"{path}: no data for {want}; the file has frequencies {', '.join(found_freqs)}")
         epoch = grids[0].epoch

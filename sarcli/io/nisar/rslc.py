@@ -119,7 +119,7 @@ def sniff_rslc(path: str | os.PathLike) -> bool:
         with h5py.File(path, "r") as f:
             return any(isinstance(f.get(f"science/{b}/{p}/swaths"), h5py.Group)
                        for b in ("LSAR", "SSAR") for p in ("RSLC", "SLC"))
-    except OSError:
+    except (OSError, RuntimeError, KeyError, ValueError):  # h5py on a damaged file: not sniffable
         return False
 
 
@@ -261,10 +261,12 @@ def _doppler_lut(slc: SLC, t_shift: float, n_x: int = 64) -> tuple[np.ndarray, n
 
 
 def write_rslc(path: str | os.PathLike, images: Mapping[str, SLC], meta: RslcMeta, inputs: tuple = (),
-               compression: str | None = None) -> None:
+               compression: str | None = None, parameters: Mapping[str, Any] | None = None) -> None:
     """Write SLCs (one per polarization, same grid) atomically in the NISAR RSLC layout (module docstring).
 
-    ``images``: polarization ("HH", ...) -> SLC. ``inputs``: files whose hashes go into the provenance.
+    ``images``: polarization ("HH", ...) -> SLC. ``inputs``: files whose hashes go into the provenance;
+    ``parameters``: added to the SLC's processing parameters in the root ``parameters`` (e.g. the
+    export configuration).
     Refuses (one line) an SLC without an Earth orbit, images on different grids, unknown polarizations.
     """
     if not images:
@@ -296,7 +298,7 @@ def write_rslc(path: str | os.PathLike, images: Mapping[str, SLC], meta: RslcMet
     h = float(meta.reference_height_m)
     ds_az, ds_gr = _ground_spacings(sv_file, _shifted(slc, frac, epoch), h)
     chunks = (min(n, 512), min(m, 512))
-    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, slc.parameters, inputs) as f:
+    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, {**slc.parameters, **(parameters or {})}, inputs) as f:
         f.attrs["Conventions"] = np.bytes_("CF-1.7")
         f.attrs["title"] = np.bytes_("NISAR L1 RSLC layout, written by sarcli")
         f.attrs["reference_document"] = np.bytes_("JPL D-102268 NISAR L1 RSLC product specification (layout)")
