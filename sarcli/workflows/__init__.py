@@ -15,4 +15,7 @@ are registered in :data:`WORKFLOWS` by step name.
 
 from sarcli.registry import Registry
 
-WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {})
+WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
+    "focus": "sarcli.workflows.focus",
+    "quality": "sarcli.workflows.quality",
+})
