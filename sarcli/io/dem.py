@@ -161,7 +161,7 @@ class DemTerrain:
         lat = np.asarray(lat_deg, np.float64)
         lon = np.asarray(lon_deg, np.float64)
         x, y = self._to_dem.transform(lon, lat)
-        col, row = ~self.transform * (np.asarray(x), np.asarray(y))
+        col, row = ~self.transform @ (np.asarray(x), np.asarray(y))
         h = _bilinear(self.z, np.asarray(row) - 0.5, np.asarray(col) - 0.5)  # pixel centres at +0.5
         bad = ~np.isfinite(h)
         if np.any(bad):
