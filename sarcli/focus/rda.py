@@ -649,12 +649,19 @@ class RangeDoppler:
         g, m = plan.grid, plan.model
         s, e = plan.block_rows(b)
         lines_c = np.r_[np.arange(s, e, CORRECTION_LINES), e].astype(np.int64)
-        tc = plan.raw.azimuth_time[0] + (lines_c[:, None] + g.offsets[m.columns][None, :] - g.shift) / g.prf
-        line = m.at_nodes(tc)
+        # the beam-centre time of the target on each line: zero-Doppler time + Delta(t_c), a fixed point
+        # (two steps from the scene-centre offsets: Delta moves by R0 d(theta) / V, ~30 lines per 40 Hz of
+        # centroid change at 850 km, and that time error would reach the velocity correction)
+        t_zd = plan.raw.azimuth_time[0] + (lines_c[:, None] - g.shift) / g.prf
+        r0 = g.ranges[m.columns][None, :]
+        tc = t_zd + g.offsets[m.columns][None, :] / g.prf
+        for _ in range(2):
+            q = m.at_nodes(np.broadcast_to(tc, (lines_c.size, m.columns.size)))
+            tc = t_zd + beam_centre_offset(r0, q["v"], q["s"])
+        line = m.at_nodes(np.broadcast_to(tc, (lines_c.size, m.columns.size)))
         blk = m.at(float(plan.block_time[b]))
         fdc_b = plan.block[b]["fdc"][m.columns]
-        phi, late = velocity_correction(g.ranges[m.columns][None, :], fdc_b[None, :], blk["v"][None, :], line["v"],
-                                        g.wavelength)
+        phi, late = velocity_correction(r0, fdc_b[None, :], blk["v"][None, :], line["v"], g.wavelength)
         phi = phi + (line["ph0"] - blk["ph0"][None, :])
         mu = (late + blk["dt"][None, :] - line["dt"]) * g.prf
         return lines_c, np.ascontiguousarray(phi, np.float64), np.ascontiguousarray(mu, np.float64)
