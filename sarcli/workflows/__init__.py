@@ -24,6 +24,7 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "design": "sarcli.workflows.design",
     "doppler": "sarcli.workflows.doppler",
     "export": "sarcli.workflows.export",
+    "focus": "sarcli.workflows.focus",
     "gbsar_coherence": "sarcli.workflows.gbsar_coherence",
     "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
     "gbsar_focus": "sarcli.workflows.gbsar_focus",
@@ -39,6 +40,7 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "orbit_accuracy": "sarcli.workflows.orbit_accuracy",
     "orbit_info": "sarcli.workflows.orbit_info",
     "orbit_interpolate": "sarcli.workflows.orbit_interpolate",
+    "quality": "sarcli.workflows.quality",
     "run": "sarcli.workflows.run",
     "simulate": "sarcli.workflows.simulate",
 })

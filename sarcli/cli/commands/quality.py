@@ -1,4 +1,7 @@
-"""``sarcli quality``: point-target quality of an SLC (IRW, PSLR, ISLR, position error)."""
+"""``sarcli quality``: point-target quality of an SLC (IRW, PSLR, ISLR, position error).
+
+Parses the options into :class:`sarcli.workflows.quality.Config`, runs the workflow, prints the report.
+"""
 
 from __future__ import annotations
 
@@ -7,22 +10,18 @@ from pathlib import Path
 import typer
 
 from sarcli.cli.common import emit_json, report
-from sarcli.errors import SarcliError
+from sarcli.errors import ConfigError
 
 
-def _parse_at(values: list[str]) -> list[tuple[float, float]]:
-    import math
-
+def _parse_at(values: list[str]) -> tuple[tuple[float, float], ...]:
     out = []
     for v in values:
         try:
             a, b = (float(x) for x in v.split(","))
         except ValueError:
-            raise SarcliError(f"--at {v!r}: expected TIME_S,RANGE_M (zero-Doppler time, slant range)") from None
-        if not (math.isfinite(a) and math.isfinite(b)):
-            raise SarcliError(f"--at {v!r}: the time and range must be finite numbers")
+            raise ConfigError(f"--at {v!r}: expected TIME_S,RANGE_M (zero-Doppler time, slant range)") from None
         out.append((a, b))
-    return out
+    return tuple(out)
 
 
 def quality(
@@ -45,24 +44,14 @@ def quality(
 
       sarcli quality slc.h5 --at -3.758,993644.5 --at -3.9485,992646.0
     """
-    from sarcli.focus.quality import measure_targets, truth_targets
-    from sarcli.io.slc import read_slc
+    from sarcli.workflows.quality import Config, run
 
-    slc = read_slc(slc_path)
-    if slc.azimuth_time.size < 2 or slc.slant_range.size < 2:
-        raise SarcliError(f"{slc_path}: image too small to measure")
-    positions = _parse_at(at) if at else truth_targets(slc.truth)
-    if not positions:
-        raise SarcliError(f"{slc_path}: no truth targets in the product; give positions with --at TIME_S,RANGE_M")
-    res = measure_targets(slc, positions, truth_known=not at)
+    rep = run(Config(slc=slc_path, at=_parse_at(at or [])))
     if as_json:
-        emit_json(res)
+        emit_json(rep.to_dict()["targets"])
         return
-    for i, m in enumerate(res):
-        err = f", position error {m['position_error_m']:.3f} m" if "position_error_m" in m else ""
-        report(f"target {i}: t {m['azimuth_time_s']:.6f} s, R {m['range_m']:.2f} m; IRW rg {m['irw_range_m']:.2f} m, "
-             f"az {m['irw_azimuth_m']:.2f} m; PSLR rg {m['pslr_range_db']:.2f} dB, az {m['pslr_azimuth_db']:.2f} dB; "
-             f"ISLR rg {m['islr_range_db']:.2f} dB, az {m['islr_azimuth_db']:.2f} dB{err}")
+    for line in rep.lines():
+        report(line)
 
 
 def register(app: typer.Typer) -> None:
