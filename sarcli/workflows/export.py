@@ -84,6 +84,7 @@ class NisarRslcFormat:
     def meta(self, slc: SLC, options: NisarRslcOptions, input_names: tuple[str, ...]):
         """The RSLC metadata of an SLC: processed bands and weightings from its focusing parameters
         (a sarcli SLC) or from the RSLC it was read from (``parameters["nisar"]``)."""
+        from sarcli.focus.geocode import recorded_height
         from sarcli.focus.rangecomp import chirp_band
         from sarcli.io.nisar.rslc import RslcMeta
 
@@ -101,12 +102,11 @@ class NisarRslcFormat:
         fs = slc.radar.range_sampling_rate_hz
         rw = spectral_weighting(p["range_window"], b_r, fs) if "range_window" in p else None
         aw = spectral_weighting(p["azimuth_window"], b_a, slc.prf_hz) if "azimuth_window" in p else None
-        h = float(np.asarray(slc.truth["reference_height_m"])) if slc.truth and "reference_height_m" in slc.truth \
-            else float(nisar.get("reference_height_m", 0.0))
+        h = float(nisar["terrain_height_m"]) if "terrain_height_m" in nisar else recorded_height(slc)
         return RslcMeta(processed_range_bandwidth_hz=b_r, processed_azimuth_bandwidth_hz=b_a,
                         acquired_range_bandwidth_hz=acquired, range_weighting=rw, azimuth_weighting=aw,
                         frequency=options.frequency, mission_id=options.mission_id, instrument=options.instrument,
-                        reference_height_m=h, input_names=input_names)
+                        terrain_height_m=h, input_names=input_names)
 
     def write(self, slc: SLC, output: Path, options: NisarRslcOptions, inputs: tuple[Path, ...]) -> dict[str, Any]:
         from sarcli.io.nisar.rslc import write_rslc

@@ -106,7 +106,7 @@ class RslcMeta:
     frequency: str = "A"
     mission_id: str = "sarcli"
     instrument: str = "sarcli"
-    reference_height_m: float = 0.0
+    terrain_height_m: float = 0.0
     input_names: tuple[str, ...] = ()
     algorithms: dict[str, str] = field(default_factory=dict)
 
@@ -295,7 +295,7 @@ def write_rslc(path: str | os.PathLike, images: Mapping[str, SLC], meta: RslcMet
     t = slc.azimuth_time + frac
     r = slc.slant_range
     root_name, band_letter = _band_of(slc.radar.carrier_frequency_hz)
-    h = float(meta.reference_height_m)
+    h = float(meta.terrain_height_m)
     ds_az, ds_gr = _ground_spacings(sv_file, _shifted(slc, frac, epoch), h)
     chunks = (min(n, 512), min(m, 512))
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, {**slc.parameters, **(parameters or {})}, inputs) as f:
@@ -421,7 +421,7 @@ def _write_processing(md: h5py.Group, slc: SLC, meta: RslcMeta, frac: float, uni
          "used by the focuser)", "hertz")
     _write_weighting(par, "rangeChirpWeighting", meta.range_weighting, "range")
     _write_weighting(par, "azimuthChirpWeighting", meta.azimuth_weighting, "azimuth")
-    _put(par, "referenceTerrainHeight", np.full(y.size, meta.reference_height_m, np.float32),
+    _put(par, "referenceTerrainHeight", np.full(y.size, meta.terrain_height_m, np.float32),
          "Reference terrain height as a function of time", "meters")
     _put(par, "runConfigurationContents", json.dumps(to_jsonable(dict(slc.parameters)), sort_keys=True),
          "sarcli processing parameters (JSON)")
@@ -742,7 +742,7 @@ def _read_parameters(par: h5py.Group | None, frequency: str, path: Path, epoch: 
     if isinstance(par.get("referenceTerrainHeight"), h5py.Dataset):
         hgt = np.asarray(par["referenceTerrainHeight"][()], np.float64).reshape(-1)
         if hgt.size and np.all(np.isfinite(hgt)):
-            nisar["reference_height_m"] = float(np.mean(hgt))
+            nisar["terrain_height_m"] = float(np.mean(hgt))
     return dop, nisar
 
 
