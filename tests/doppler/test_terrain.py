@@ -238,7 +238,7 @@ def test_reference_height_is_an_input_not_read_from_the_truth(high_raw, cli, tmp
         r = cli("doppler", path, "--height", height, "--az-block", "512", "--rg-block", "96", "-o", out)
         assert r.exit_code == 0, r.stderr
         m = read_doppler(out)
-        assert m.parameters["height"] == height
+        assert m.parameters["height_m"] == height
         b = m.blocks
         errs[height] = np.max(np.abs(b["fdc_orbit_hz"] - np.interp(b["range_m"], rho, tf)))
     assert errs[1500.0] < 0.01 < 1.0 < errs[0.0]
