@@ -17,10 +17,13 @@ from sarcli.workflows.base import Progress, Provenance, Report, using
 
 @dataclass(frozen=True)
 class Config:
-    """slc: the SLC product; at: targets as (zero-Doppler time s, slant range m); empty: the truth's."""
+    """slc: the focused image (a sarcli SLC, or a NISAR RSLC: ``frequency``/``polarization`` choose its
+    layer); at: targets as (zero-Doppler time s, slant range m); empty: the truth's."""
 
     slc: Path
     at: tuple[tuple[float, float], ...] = ()
+    frequency: str | None = None
+    polarization: str | None = None
 
     def __post_init__(self) -> None:
         for t, r in self.at:
@@ -48,10 +51,10 @@ class QualityReport(Report):
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> QualityReport:
     """Measure the targets of ``config`` in the SLC (reads only)."""
     from sarcli.focus.quality import measure_targets, truth_targets
-    from sarcli.io.slc import read_slc
+    from sarcli.io.nisar.rslc import read_image
 
     with using(provenance):
-        slc = read_slc(config.slc)
+        slc = read_image(config.slc, config.frequency, config.polarization)
         if slc.azimuth_time.size < 2 or slc.slant_range.size < 2:
             raise ProductError(f"{config.slc}: image too small to measure")
         positions = list(config.at) if config.at else truth_targets(slc.truth)

@@ -177,3 +177,22 @@ def test_workflow_refusals(sim_rslc, sim_reflectors_csv, tmp_path):
         run(Config(sim_rslc, sim_reflectors_csv, plots=tmp_path / "absent"))
     with pytest.raises(ConfigError, match="has polarizations HH, not VV"):
         run(Config(sim_rslc, sim_reflectors_csv, polarization="VV"))
+
+
+def test_quality_cli_with_corner_reflectors_and_on_an_rslc(cli, sim_rslc, sim_reflectors_csv, tmp_path):
+    """``sarcli quality --corner-reflectors --json``: one object per reflector with exactly the documented keys
+    (same values as the workflow) and one IRF picture per reflector with ``--plots``."""
+    from sarcli.calibration.analysis import RECORD_KEYS
+    from sarcli.workflows.corner_reflectors import Config, run
+
+    r = cli("quality", sim_rslc, "--corner-reflectors", sim_reflectors_csv, "--json")
+    assert r.exit_code == 0, r.stderr
+    recs = json.loads(r.stdout)
+    assert [tuple(x) for x in recs] == [RECORD_KEYS] * 3
+    assert recs == json.loads(json.dumps(run(Config(sim_rslc, sim_reflectors_csv)).records()))
+    plots = tmp_path / "plots"
+    plots.mkdir()
+    r = cli("quality", sim_rslc, "--corner-reflectors", sim_reflectors_csv, "--plots", plots)
+    assert r.exit_code == 0 and sorted(p.name for p in plots.iterdir()) == ["cr_T0.png", "cr_T1.png", "cr_T2.png"]
+    r = cli("quality", sim_rslc, "--plots", plots)
+    assert r.exit_code == 2 and r.stderr.strip() == "sarcli: error: --plots goes with --corner-reflectors"
