@@ -92,3 +92,22 @@ def test_info_summarizes_an_exported_rslc(cli, sim_rslc):
     assert r.exit_code == 0, r.stderr
     s = json.loads(r.stdout)
     assert s["product_type"] == "nisar_rslc" and s["main_dataset"] == "/science/LSAR/RSLC/swaths/frequencyA/HH"
+
+
+def test_info_describes_an_rslc_without_sarcli_provenance(cli, sim_rslc, tmp_path):
+    """An RSLC written by another tool carries no ``product_type``: info recognises the layout itself."""
+    import shutil
+
+    import h5py
+
+    other = tmp_path / "isce3_like.h5"
+    shutil.copy(sim_rslc, other)
+    with h5py.File(other, "r+") as f:
+        del f.attrs["product_type"]
+    r = cli("info", other, "--json")
+    assert r.exit_code == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert s["product_type"] == "nisar_rslc" and s["frequencies"] == {"frequencyA": ["HH"]}
+    assert s["shape"] == [2048, 1536]
+    r = cli("info", other)
+    assert r.exit_code == 0 and "NISAR RSLC (L-band" in r.stdout and "frequencyA: HH" in r.stdout
