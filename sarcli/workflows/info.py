@@ -61,7 +61,7 @@ class Report(base.Report):
             return _geotiff_lines(s)
         if s.get("product_type") == "nisar_rslc" and "frequencies" in s:
             layers = "; ".join(f"{k}: {', '.join(v)}" for k, v in s["frequencies"].items())
-            return [f"{s['file']}: NISAR RSLC ({s["band"]}-band, mission {s['mission_id']}), image {s['shape'][0]} x "
+            return [f"{s['file']}: NISAR RSLC ({s['band']}-band, mission {s['mission_id']}), image {s['shape'][0]} x "
                     f"{s['shape'][1]}; layers {layers}"]
         if "products" in s:
             out = [f"{s['file']}: raw input ({s['format']}), {len(s['products'])} data sets"]
