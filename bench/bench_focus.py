@@ -9,6 +9,9 @@
 4. Accuracy vs cost on the simulator's Radarsat-1 point-target scene (samples/rs1_point.toml, rect
    windows, true Doppler): RCMC kernel, range oversampling, SRC on/off, float32 vs float64, RD vs
    backprojection -> IRW, PSLR, ISLR, position error and seconds; table and plot.
+5. Block invariance on the same scene with the Doppler ESTIMATED by sarcli.doppler (it and the
+   orbit's V vary along azimuth): blocks of 1024, 2048 and 4096 lines (3, 2 and 1 blocks) -> the
+   largest phase, amplitude and position differences of the targets between block sizes.
 
 Run: ``python -m bench.run_all bench_focus`` (BENCH_FOCUS_QUICK=1 skips the full-size scene).
 """
@@ -202,6 +205,40 @@ def bench_accuracy() -> dict:
             "rows": rows}
 
 
+def bench_block_invariance() -> dict:
+    from sarcli.doppler.api import estimate_doppler
+    from sarcli.focus.quality import point_target_metrics, truth_targets
+    from sarcli.focus.rda import focus_rd
+    from sarcli.sim.scene import load_scene
+    from sarcli.sim.stripmap import simulate
+
+    raw = simulate(load_scene(REPO / "samples" / "rs1_point.toml"))
+    dop = estimate_doppler(raw)
+    res = {}
+    for bl in (1024, 2048, 4096):
+        slc = focus_rd(raw, dop, block_lines=bl)
+        nv = slc.parameters["block_output_lines"]
+        rows = []
+        for tz, r0 in truth_targets(raw.truth):
+            row = (tz - slc.azimuth_time[0]) * slc.prf_hz
+            col = (r0 - slc.slant_range[0]) / slc.range_spacing_m
+            b = min(int(round(row)) // nv, slc.doppler.block_time.size - 1)
+            m = point_target_metrics(slc.image, row, col,
+                                     azimuth_carrier=slc.doppler.fdc_hz[b, int(round(col))] / slc.prf_hz)
+            rows.append((m["peak_amplitude"], m["peak_phase_rad"], m["row"] - row))
+        res[bl] = (np.array(rows), slc.parameters["n_blocks"])
+    ref = res[4096][0]
+    out = {}
+    for bl in (1024, 2048):
+        m = res[bl][0]
+        out[str(bl)] = {"n_blocks": res[bl][1],
+                        "max_phase_diff_rad": float(np.max(np.abs(np.angle(np.exp(1j * (m[:, 1] - ref[:, 1])))))),
+                        "max_amplitude_diff": float(np.max(np.abs(m[:, 0] / ref[:, 0] - 1))),
+                        "max_position_diff_lines": float(np.max(np.abs(m[:, 2] - ref[:, 2])))}
+    out["max_position_error_lines"] = float(max(np.max(np.abs(res[b][0][:, 2])) for b in res))
+    return out
+
+
 def _plot(acc: dict, path: Path) -> None:
     import matplotlib
 
@@ -234,6 +271,7 @@ def main() -> None:
         data["block"] = bench_block()
         data["compile"] = bench_compile(tmp)
         data["accuracy"] = bench_accuracy()
+        data["block_invariance"] = bench_block_invariance()
         if not quick:
             data["full"] = bench_full(tmp)
     RESULTS.mkdir(parents=True, exist_ok=True)
@@ -266,6 +304,14 @@ def main() -> None:
                                r["pslr_azimuth_db"], r["islr_range_db"], r["islr_azimuth_db"], r["position_error_m"]]
                               for r in a["rows"]]))
     md.append("\nPlot: bench/results/bench_focus_accuracy.png\n")
+    bi = data["block_invariance"]
+    md += ["### Block invariance (rs1_point, estimated Doppler, orbit timing; vs blocks of 4096 lines)", ""]
+    md.append(markdown_table(["block lines", "blocks", "max phase diff rad", "max amplitude diff",
+                              "max position diff lines"],
+                             [[k, v["n_blocks"], v["max_phase_diff_rad"], v["max_amplitude_diff"],
+                               v["max_position_diff_lines"]] for k, v in bi.items() if isinstance(v, dict)]))
+    md.append(f"\nLargest azimuth position error against the truth, any block size: "
+              f"{bi['max_position_error_lines']:.4f} line.\n")
     write_results("bench_focus", "\n".join(md), json.loads(json.dumps(data, default=float)))
 
 

@@ -34,15 +34,6 @@ def true_window(pair: Pair, res: MoverResult, half_rows: int = 90, half_cols: in
             slice(max(0, col - half_cols), min(m, col + half_cols + 1)))
 
 
-def truth_movers(raw: Any) -> list[dict]:
-    """Positions (LOCAL x, y) of the simulated product's truth targets, flagged moving or not."""
-    tab = (raw.truth or {}).get("targets")
-    if tab is None:
-        return []
-    return [{"x_m": float(r["x_m"]), "y_m": float(r["y_m"]),
-             "moving": bool(abs(r["vel_x_mps"]) + abs(r["vel_y_mps"]) > 0)} for r in tab]
-
-
 def y_local(pair: Pair, row: float | np.ndarray) -> Any:
     """LOCAL along-track position (m) of a (fractional) image row."""
     t = pair.slc0.azimuth_time

@@ -1,8 +1,10 @@
 """Amplitude GeoTIFFs of an SLC: slant-range geometry with a lat/lon GCP grid, and map-projected (UTM).
 
 Geolocation of a pixel (line time t = zero-Doppler time, column = slant range R) is the zero-Doppler
-target at height h (the truth's reference height for simulated scenes, else 0):
-:func:`sarcli.focus.geolocation.zero_doppler_points` (orbit.geometry, WGS-84).
+target on the terrain (``--height`` / ``--dem``, :mod:`sarcli.io.dem`; default 0 m above the
+ellipsoid): :func:`sarcli.focus.geolocation.zero_doppler_points` (orbit.geometry, WGS-84, iterated
+with the DEM height under the point). A pixel placed at a height dh too low lands dh / tan(incidence)
+too far from the track on the ground (a 1 km hill at Radarsat-1's incidence of about 38 deg: 1.3 km).
 
 - Slant-range GeoTIFF: the (multilooked) amplitude as it is, with a ``gcp_lines x gcp_cols`` grid of
   ground control points (pixel centres, EPSG:4326 lon/lat/h).
@@ -20,6 +22,7 @@ import numpy as np
 
 from sarcli.errors import SarcliError
 from sarcli.model.slc import SLC
+from sarcli.model.terrain import ConstantHeight, Terrain
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
@@ -39,9 +42,15 @@ def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.nda
     return out
 
 
-def reference_height(slc: SLC) -> float:
-    if slc.truth is not None and "reference_height_m" in slc.truth:
-        return float(np.asarray(slc.truth["reference_height_m"]))
+def recorded_height(slc: SLC) -> float:
+    """The terrain height the product was focused with (``parameters["terrain"]``: the constant height,
+    or the DEM's mean height), 0 m when it records none: a first-order height for quantities that
+    depend weakly on it (ground spacings)."""
+    t = slc.parameters.get("terrain") if isinstance(slc.parameters, dict) else None
+    if isinstance(t, dict):
+        for key in ("height_m", "mean_height_m"):
+            if isinstance(t.get(key), int | float) and np.isfinite(t[key]):
+                return float(t[key])
     return 0.0
 
 
@@ -53,7 +62,7 @@ def _look_axes(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int]):
 
 
 def geolocate_grid(slc: SLC, rows: np.ndarray, cols: np.ndarray, t: np.ndarray, r: np.ndarray,
-                   height: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   terrain: Terrain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(lat_deg, lon_deg, h) at the grid rows x cols of axes t (lines) and r (columns)."""
     from orbit.geodetic import ecef_to_geodetic
     from sarcli.focus.geolocation import zero_doppler_points
@@ -62,7 +71,7 @@ def geolocate_grid(slc: SLC, rows: np.ndarray, cols: np.ndarray, t: np.ndarray, 
         raise SarcliError("GeoTIFF needs an Earth orbit (ECI/ECEF state vectors); this product has "
                           f"{'none' if slc.orbit is None else 'a LOCAL (flat) frame'}")
     tt, rr = np.meshgrid(t[rows], r[cols], indexing="ij")
-    p = zero_doppler_points(slc.orbit, slc.epoch_utc, tt, rr, slc.radar.wavelength_m, slc.look_side, height)
+    p = zero_doppler_points(slc.orbit, slc.epoch_utc, tt, rr, slc.radar.wavelength_m, slc.look_side, terrain)
     return ecef_to_geodetic(p)
 
 
@@ -70,12 +79,12 @@ def _grid_index(n: int, k: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, n - 1, max(2, min(k, n)))).astype(int))
 
 
-def slant_gcps(slc: SLC, shape: tuple[int, int], looks_az: int, looks_rg: int, gcp_lines: int = 10,
-               gcp_cols: int = 10) -> list[tuple[float, float, float, float, float]]:
+def slant_gcps(slc: SLC, shape: tuple[int, int], looks_az: int, looks_rg: int, terrain: Terrain,
+               gcp_lines: int = 10, gcp_cols: int = 10) -> list[tuple[float, float, float, float, float]]:
     """GCPs (row, col, lon, lat, h) at pixel centres of the multilooked raster."""
     t, r = _look_axes(slc, looks_az, looks_rg, shape)
     rows, cols = _grid_index(shape[0], gcp_lines), _grid_index(shape[1], gcp_cols)
-    lat, lon, h = geolocate_grid(slc, rows, cols, t, r, reference_height(slc))
+    lat, lon, h = geolocate_grid(slc, rows, cols, t, r, terrain)
     return [(rows[i] + 0.5, cols[j] + 0.5, float(lon[i, j]), float(lat[i, j]), float(h[i, j]))
             for i in range(rows.size) for j in range(cols.size)]
 
@@ -86,8 +95,9 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
     return (32600 if lat_deg >= 0 else 32700) + zone
 
 
-def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None) -> None:
-    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326)."""
+def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
+                        terrain: Terrain | None = None) -> None:
+    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m)."""
     import warnings
 
     from rasterio.errors import NotGeoreferencedWarning
@@ -95,7 +105,7 @@ def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ta
     from sarcli.io.images import write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg)
-    gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg)
+    gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg, terrain or ConstantHeight(0.0))
     with warnings.catch_warnings():
         # the GCPs are attached after the file is opened: rasterio warns in between
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -104,8 +114,11 @@ def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ta
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                spacing_m: float | None = None, coarse: int = 33, strip: int = 512):
-    """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection."""
+                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = 512):
+    """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection,
+    pixels placed on ``terrain`` (default 0 m). With a DEM the coarse grid is made denser (``coarse``
+    at least 65): the inverse map is linear per triangle, and the terrain bends it on the scale of
+    the hills."""
     from pyproj import Transformer
     from rasterio.transform import Affine
     from scipy.interpolate import LinearNDInterpolator
@@ -115,7 +128,11 @@ def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None 
     n, m = inten.shape
     t, r = _look_axes(slc, looks_az, looks_rg, inten.shape)
     rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
-    lat, lon, _ = geolocate_grid(slc, rows, cols, t, r, reference_height(slc))
+    terrain = terrain or ConstantHeight(0.0)
+    if not isinstance(terrain, ConstantHeight):
+        coarse = max(coarse, 65)
+        rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
+    lat, lon, _ = geolocate_grid(slc, rows, cols, t, r, terrain)
     if crs is None:
         crs = f"EPSG:{utm_epsg(float(np.mean(lat)), float(np.mean(lon)))}"
     try:
@@ -155,11 +172,11 @@ def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None 
 
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                      spacing_m: float | None = None, tags: dict | None = None) -> str:
+                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None) -> str:
     """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used."""
     from sarcli.io.images import write_geotiff
 
-    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m)
+    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m, terrain)
     write_geotiff(path, amp, crs, transform=transform, tags=tags,
                   band_description="amplitude, map projected (bilinear intensity resampling)")
     return crs

@@ -1,7 +1,9 @@
-"""Positions of image pixels: the zero-Doppler target of (azimuth time t, slant range R, height h).
+"""Positions of image pixels: the zero-Doppler target of (azimuth time t, slant range R) on the terrain.
 
 Earth-fixed products (orbit frame ECI or ECEF): ``orbit.geometry.geolocate`` with Doppler 0 in ECEF
-(Hermite-interpolated state vectors, exact WGS-84 height). LOCAL products (flat Earth, z up): the
+(Hermite-interpolated state vectors, exact WGS-84 height). The terrain (:mod:`sarcli.model.terrain`:
+a constant height or a DEM) gives the height under the point, which moves the point: the solve is
+iterated (:func:`geolocate_on_terrain`). LOCAL products (flat Earth, z up): the
 point at height h, range R from the antenna, perpendicular to its velocity, on the look side:
 ``T = P + a r_hat + b u_hat + (h - P_z) z_hat`` with u_hat the horizontal flight direction,
 r_hat = u_hat x z_hat (right) or its opposite (left), ``b = -(h - P_z) V_z / |V_h|`` (zero Doppler)
@@ -12,8 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ProductError, SarcliError
 from sarcli.model.raw import Orbit
+from sarcli.model.terrain import ConstantHeight, Terrain
+
+TERRAIN_TOL_M = 0.05  # stop when no point moved more than this (m) in one iteration
+TERRAIN_MAX_ITER = 30
 
 
 def state_vectors(orbit: Orbit | None, epoch_utc: str):
@@ -33,20 +39,54 @@ def platform_state(orbit: Orbit | None, epoch_utc: str, t: np.ndarray) -> tuple[
     return pos, vel
 
 
-def zero_doppler_points(orbit: Orbit | None, epoch_utc: str, t, rho, wavelength: float, side: str = "right",
-                        height=0.0) -> np.ndarray:
-    """Target positions (broadcast shape + (3,)) in ECEF (Earth frames) or LOCAL metres."""
-    from orbit.errors import GeometryError
+def geolocate_on_terrain(sv, t, rho, wavelength: float, fdc, side: str, terrain: Terrain) -> np.ndarray:
+    """ECEF points (broadcast shape + (3,)) at azimuth time t, slant range rho and Doppler fdc ON the terrain.
+
+    A constant height is one solve. With a DEM the height under the point moves the point: solve at
+    the scene's mean height h_0, read the DEM under the result, solve again, until no point moves more
+    than ``TERRAIN_TOL_M``. A height error dh moves the point by about dh / tan(incidence) across
+    track, where the terrain differs by slope x that: the iteration contracts by slope / tan(incidence)
+    per step and converges wherever the terrain is not steeper than the incidence (no layover);
+    points in layover are refused in one line.
+    """
+    from orbit.geodetic import ecef_to_geodetic
     from orbit.geometry import geolocate
 
+    t, rho, fdc = np.broadcast_arrays(np.asarray(t, np.float64), np.asarray(rho, np.float64),
+                                      np.asarray(fdc, np.float64))
+    if isinstance(terrain, ConstantHeight):
+        return geolocate(sv, t, rho, wavelength, fdc, terrain.height_m, side)
+    h = np.full(t.shape, float(getattr(terrain, "mean_height_m", 0.0)))
+    p = geolocate(sv, t, rho, wavelength, fdc, h, side)
+    for _ in range(TERRAIN_MAX_ITER):
+        lat, lon, _ = ecef_to_geodetic(p)
+        h = np.asarray(terrain.height(lat, lon), np.float64)
+        q = geolocate(sv, t, rho, wavelength, fdc, h, side)
+        moved = float(np.max(np.linalg.norm(q - p, axis=-1))) if q.size else 0.0
+        p = q
+        if moved < TERRAIN_TOL_M:
+            return p
+    raise ProductError(f"geolocation on the DEM did not converge in {TERRAIN_MAX_ITER} iterations (last move "
+                       f"{moved:.2f} m): terrain steeper than the incidence angle (layover)")
+
+
+def zero_doppler_points(orbit: Orbit | None, epoch_utc: str, t, rho, wavelength: float, side: str = "right",
+                        terrain: Terrain | None = None) -> np.ndarray:
+    """Target positions (broadcast shape + (3,)) in ECEF (Earth frames, on ``terrain``, default 0 m) or
+    LOCAL metres (a constant height only: a DEM needs an Earth frame)."""
+    from orbit.errors import GeometryError
+
+    terrain = terrain or ConstantHeight(0.0)
     sv = state_vectors(orbit, epoch_utc)
-    t, rho, height = np.broadcast_arrays(np.asarray(t, np.float64), np.asarray(rho, np.float64),
-                                         np.asarray(height, np.float64))
+    t, rho = np.broadcast_arrays(np.asarray(t, np.float64), np.asarray(rho, np.float64))
     if sv.frame != "LOCAL":
         try:
-            return geolocate(sv, t, rho, wavelength, 0.0, height, side)
+            return geolocate_on_terrain(sv, t, rho, wavelength, 0.0, side, terrain)
         except GeometryError as e:
             raise SarcliError(f"geolocation failed: {e}") from None
+    if not isinstance(terrain, ConstantHeight):
+        raise SarcliError("a DEM needs a product with an Earth orbit (ECI/ECEF); this one has a LOCAL (flat) frame")
+    height = np.full(t.shape, float(terrain.height_m))
     p, v, _ = sv.interpolate(t, max_extrapolation_s=1.0)
     vh = np.hypot(v[..., 0], v[..., 1])
     u = np.stack([v[..., 0] / vh, v[..., 1] / vh, np.zeros_like(vh)], -1)

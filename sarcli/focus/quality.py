@@ -192,14 +192,15 @@ def azimuth_ground_spacing(slc) -> float:
     """Azimuth pixel spacing on the ground (m): geolocated with an Earth orbit, else V_eff / PRF."""
     if slc.orbit is None or slc.orbit.frame not in ("ECI", "ECEF") or slc.azimuth_time.size < 2:
         return float(slc.azimuth_spacing_m)
-    from sarcli.focus.geocode import reference_height
+    from sarcli.focus.geocode import recorded_height
     from sarcli.focus.geolocation import zero_doppler_points
+    from sarcli.model.terrain import ConstantHeight
 
     n = slc.azimuth_time.size
     a, b = max(0, n // 2 - 50), min(n - 1, n // 2 + 50)
     r = slc.slant_range[slc.slant_range.size // 2]
     p = zero_doppler_points(slc.orbit, slc.epoch_utc, slc.azimuth_time[[a, b]], r, slc.radar.wavelength_m,
-                            slc.look_side, reference_height(slc))
+                            slc.look_side, ConstantHeight(recorded_height(slc)))
     return float(np.linalg.norm(p[1] - p[0]) / (b - a))
 
 

@@ -1,4 +1,4 @@
-"""Range-Doppler algorithm (RDA), processed in azimuth blocks with overlap (bounded memory).
+"""Range-Doppler algorithm (RDA) [CumWong2005, ch. 6], processed in azimuth blocks with overlap (bounded memory).
 
 Per block of output lines [s, e) the raw lines [s - P, e + P) are read (zeros beyond the scene), with
 P = ceil(aperture/2 + residual shift) lines so that every output line sees its whole processed
@@ -11,14 +11,36 @@ aperture, and processed as
 3. per chunk of azimuth-frequency rows inside the processed band, ONE pass in the 2-D frequency domain
    (:func:`sarcli.focus.rangecomp.apply_range_filter_2d`): range matched filter x optional SRC at the
    mid-swath range x Fourier zero padding to ``rcmc_oversample`` x L (2x upsampling, knob); range IFFT;
-4. RCMC + azimuth matched filter with the range-dependent centroid and rate of that block
-   (:mod:`sarcli.focus.rcmc`), evaluated from the Doppler model at the block's centre time, written
-   into the first n_samples columns of the block;
-5. azimuth IFFT of those columns; lines [P, P + e - s) of the block are output lines [s, e).
+4. RCMC + azimuth matched filter with the range-dependent centroid and rate of the block
+   (:mod:`sarcli.focus.rcmc`), written into the first n_samples columns of the block;
+5. azimuth IFFT of those columns; lines [P, P + e - s) of the block are output lines [s, e);
+6. per output line, the correction from the block's model to the model at that line's own time
+   (:meth:`RangeDoppler.line_corrections`): the block size does not change the focused image.
 
-Range compression, SRC and upsampling thus cost one range FFT and one range IFFT (the former design
-compressed, transformed back and forth again for SRC and upsampling: two more range passes).
-FFT lengths are 5-smooth (:func:`smooth_len`): pocketfft is markedly slower on factors 7 and 11.
+Block invariance. The Doppler model and the orbit-timing correction vary along azimuth (the
+effective velocity V of an orbit by ~0.04 m/s per second, a centroid estimate by tens of Hz per
+second), but in the range-Doppler domain one filter serves a whole block. The model is therefore
+evaluated once, in the plan, on a fixed time grid (every ``GRID_LINES`` lines, every ``GRID_SAMPLES``
+range samples, the same grid whatever the block layout) and interpolated linearly to each block's
+centre (the filter) and to each output line's beam-centre time t_c (the correction). What a
+different V does to a point target (derivation in :func:`velocity_correction`): with the
+migration factor D(f, V) = sqrt(1 - (lam f / 2V)^2) the residual spectral phase is
+E(f) = (4 pi R0 / lam)(D(f, V_block) - D(f, V(t_c))) = E0 + E1 (f - f_c) + E2 (f - f_c)^2 + ...
+around the band centre f_c; E1 shifts the peak by -E1 / 2 pi and the phase AT the shifted peak is
+E0 - E1 f_c (the tangent's intercept at f = 0: the image carries the absolute carrier f_c). At
+Radarsat-1's squint (-5.3 PRF) dE/dV is 22 rad per m/s, so a block of 4096 lines (3.3 s) spans
+about 3 rad and 0.07 line; E2 is 1/300 of it (0.13 rad per m/s at the edges of a 1000 Hz band).
+Likewise the orbit-timing correction: its time shift dt and phase ph0 belong to each line's own
+time. So each output pixel is taken at its corrected time (line + mu, mu = -E1 / 2 pi + dt_block -
+dt(t_c), in lines: 16-tap band-pass sinc interpolation at the absolute carrier,
+:func:`correct_lines`, skipped when |mu| < ``SHIFT_TOL_LINES`` everywhere in the block) and rotated
+by -(E0 - E1 f_c) + ph0(t_c) - ph0_block. What remains between block sizes: E2, the interpolation
+error (< 0.7 % at the band edge for |mu| <= 0.1 line, tests), and the azimuth window's centre
+(the block's centroid: second order in the centroid change, 0.03 % of amplitude in the tests).
+Linear interpolation on the grid errs by (h^2 / 8) |q''| for a quantity q, h = 256 lines (0.2 s):
+a polynomial Doppler fit or an orbit varies on scales of the scene or of minutes, so this is below
+1e-3 of the correction. Measured (tests): phases across block sizes 512 .. whole scene agree to
+3e-3 rad, amplitudes to 0.03 %, positions to 1e-3 line.
 
 Output geometry: column i is closest-approach slant range ``r_first + i dr`` (the raw range grid); line
 j has ZERO-DOPPLER time ``t_raw[j] - shift/PRF``, where ``shift`` (integer lines) is the beam-centre
@@ -28,6 +50,8 @@ need no more overlap than broadside ones. Lines closer than half an aperture to 
 only part of their aperture (``first_full_line`` / ``last_full_line``; a warning when none is whole).
 Peak extra memory per block: the N x L block (complex64) plus a chunk of upsampled rows (bench_focus
 reports it against a 1536 x 2048 input, including the output image).
+
+FFT lengths are 5-smooth (:func:`smooth_len`): pocketfft is markedly slower on factors 7 and 11.
 """
 
 from __future__ import annotations
@@ -39,12 +63,15 @@ import time
 import warnings
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field
+from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
+from numba import njit, prange
 
-from sarcli.errors import SarcliError
+from sarcli.config import to_mapping
+from sarcli.errors import ConfigError, SarcliError
 from sarcli.focus.interp import parse_interpolator, table_for
 from sarcli.focus.kinematics import aperture_time, beam_centre_offset, velocity_and_squint
 from sarcli.focus.rangecomp import (
@@ -58,9 +85,15 @@ from sarcli.focus.rcmc import rcmc_azimuth
 from sarcli.focus.windows import parse_window, window_table
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
+from sarcli.model.terrain import ConstantHeight, Terrain
 
 RANGE_GUARD = 64  # range samples beyond the correlation's wrap-free length (SRC impulse response)
 CHUNK = 64  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass
+GRID_LINES = 256  # model grid: a node every GRID_LINES lines (module docstring: interpolation error)
+GRID_SAMPLES = 32  # ... and every GRID_SAMPLES range samples (and the last one)
+CORRECTION_LINES = 16  # per-line correction computed every 16 output lines, linear in between
+SHIFT_TOL_LINES = 1e-3  # per-line time shifts below this (lines) are not applied (phase only)
+SHIFT_INTERPOLATOR = "sinc16"  # azimuth interpolator of the per-line shift (tests: error < 1e-4 in band)
 
 
 def smooth_len(n: int) -> int:
@@ -77,19 +110,21 @@ def smooth_len(n: int) -> int:
 
 
 @dataclass(frozen=True)
-class RdKnobs:
+class RdOptions:
     """Processing knobs of the RDA (each one's accuracy/cost is measured in bench/bench_focus.py).
 
     range_window, azimuth_window: window specs (:mod:`sarcli.focus.windows`); range_bandwidth_fraction:
     processed part of the chirp band (1 = all of it); azimuth_bandwidth_hz:
     processed Doppler band (default 0.8 PRF); rcmc: interpolator (nearest, linear, sinc4/8/16);
     src: secondary range compression; precision: "single" (complex64) or "double" (complex128);
-    block_lines: azimuth FFT length per block; use_replica: the product's replica, else the nominal chirp;
+    block_lines: azimuth FFT length per block (memory; the image does not depend on it, see the
+    module docstring); use_replica: the product's replica, else the nominal chirp;
     rcmc_oversample: 1 or 2, range Fourier upsampling before the RCMC interpolation (a windowed sinc
     attenuates frequencies near half the sampling rate: 8 taps pass only 0.31 of a component at
     0.467 cycles/sample, the edge of a Radarsat-1 chirp sampled at 1.07 x its band);
     orbit_timing: with an Earth orbit, place targets at their exact zero-Doppler time (see
-    :func:`orbit_time_correction`) instead of the hyperbolic model's.
+    :func:`orbit_time_correction`) instead of the hyperbolic model's; workers: threads (scipy's
+    convention: negative = every usable core).
     """
 
     range_window: str = "kaiser:2.5"
@@ -98,31 +133,28 @@ class RdKnobs:
     azimuth_bandwidth_hz: float | None = None
     rcmc: str = "sinc8"
     src: bool = True
-    precision: str = "single"
+    precision: Literal["single", "double"] = "single"
     block_lines: int = 4096
     use_replica: bool = True
     rcmc_oversample: int = 2
     orbit_timing: bool = True
     workers: int = -1
 
-
-def make_knobs(**kw) -> RdKnobs:
-    """RdKnobs from keyword arguments, refusing unknown names and bad values in one line."""
-    names = set(RdKnobs.__dataclass_fields__)
-    bad = sorted(set(kw) - names)
-    if bad:
-        raise SarcliError(f"unknown focus option(s) {', '.join(bad)}; known: {', '.join(sorted(names))}")
-    k = RdKnobs(**{n: v for n, v in kw.items() if v is not None or n == "azimuth_bandwidth_hz"})
-    parse_window(k.range_window)
-    parse_window(k.azimuth_window)
-    parse_interpolator(k.rcmc)
-    if k.precision not in ("single", "double"):
-        raise SarcliError(f"precision must be 'single' or 'double', got {k.precision!r}")
-    if k.rcmc_oversample not in (1, 2):
-        raise SarcliError(f"rcmc_oversample must be 1 or 2, got {k.rcmc_oversample}")
-    if k.block_lines < 64:
-        raise SarcliError(f"block_lines must be at least 64, got {k.block_lines}")
-    return k
+    def __post_init__(self) -> None:
+        parse_window(self.range_window)
+        parse_window(self.azimuth_window)
+        parse_interpolator(self.rcmc)
+        if self.precision not in ("single", "double"):
+            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
+        if self.rcmc_oversample not in (1, 2):
+            raise ConfigError(f"rcmc_oversample must be 1 or 2, got {self.rcmc_oversample}")
+        if self.block_lines < 64:
+            raise ConfigError(f"block_lines must be at least 64, got {self.block_lines}")
+        if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
+            raise ConfigError(f"range_bandwidth_fraction must be in (0, 1], got {self.range_bandwidth_fraction}")
+        if self.azimuth_bandwidth_hz is not None and not (math.isfinite(self.azimuth_bandwidth_hz)
+                                                          and self.azimuth_bandwidth_hz > 0):
+            raise ConfigError(f"azimuth_bandwidth_hz must be a positive number of Hz, got {self.azimuth_bandwidth_hz}")
 
 
 def _uniform_prf(t: np.ndarray, radar_prf: float) -> float:
@@ -136,15 +168,15 @@ def _uniform_prf(t: np.ndarray, radar_prf: float) -> float:
     return 1.0 / med
 
 
-def doppler_on_grid(doppler, r0: np.ndarray, t: float, wavelength: float):
-    """(fdc, fr, V, sin_squint) per closest range r0 at raw time t.
+def doppler_on_grid(doppler, r0: np.ndarray, t, wavelength: float):
+    """(fdc, fr, V, sin_squint) per closest range r0 at raw time(s) t (broadcast with r0).
 
     The model is indexed by beam-centre range R_c = R0 / cos(theta): evaluated at R0 first, then at
     the R_c that this gives (one refinement; fdc and fr vary slowly with range). Refuses NaN/inf.
     """
-    tt = np.full_like(r0, t)
-    fdc = np.asarray(doppler.fdc(r0, tt), np.float64)
-    fr = np.asarray(doppler.fr(r0, tt), np.float64)
+    r0, tt = np.broadcast_arrays(np.asarray(r0, np.float64), np.asarray(t, np.float64))
+    fdc = np.broadcast_to(np.asarray(doppler.fdc(r0, tt), np.float64), r0.shape)
+    fr = np.broadcast_to(np.asarray(doppler.fr(r0, tt), np.float64), r0.shape)
     v, s = velocity_and_squint(fdc, fr, r0, wavelength)
     rc = r0 / np.sqrt(1.0 - s * s)
     fdc = np.broadcast_to(np.asarray(doppler.fdc(rc, tt), np.float64), r0.shape).copy()
@@ -177,70 +209,45 @@ def _coverage_warnings(doppler, r: np.ndarray, t: np.ndarray) -> list[str]:
     return out
 
 
-def _reference_height(raw: RawProduct) -> float:
-    if raw.truth is not None and "reference_height_m" in raw.truth:
-        return float(np.asarray(raw.truth["reference_height_m"]))
-    return 0.0
+@dataclass(frozen=True)
+class OutputGrid:
+    """The stripmap output grid shared by the RD and backprojection focusers (:func:`plan_grid`).
 
-
-def orbit_time_correction(raw: RawProduct, t: float, r0: np.ndarray, fdc: np.ndarray, v: np.ndarray,
-                          s: np.ndarray, wavelength: float, step: int = 32) -> tuple[np.ndarray, np.ndarray]:
-    """Orbit corrections of the hyperbolic model per range bin: (time shift dt s, phase ph0 rad).
-
-    The RDA puts a target seen at beam-centre time t at ``t - Delta_model``, Delta_model = R0 tan(theta)/V,
-    with phase -4 pi R0_model / lam, R0_model = R_c cos(theta). With a squint of several PRFs Delta is
-    seconds long and the hyperbola, fitted to fdc and fr at the beam centre, misplaces the zero-Doppler
-    time by a fraction of a line (0.17 line for the Radarsat-1 sample) and the closest range by
-    millimetres (2 rad of phase). With an Earth orbit the target seen at (t, R_c = R0/cos(theta), fdc)
-    is geolocated (height: the truth's reference height, else 0) and its exact zero-Doppler time t_zd
-    and closest range R0_true solved (``orbit.geometry``): dt = Delta_model - (t - t_zd) and
-    ph0 = 4 pi (R0 - R0_true) / lam. Evaluated every ``step`` range bins, interpolated between.
-    Zeros without an Earth orbit.
+    prf (Hz), ranges (m, the raw range grid = closest ranges of the output columns), wavelength (m),
+    ba (processed Doppler band, Hz), shift (integer lines: output line j has zero-Doppler time
+    t_raw[j] - shift / PRF), offsets (beam-centre offset Delta PRF per column at scene centre, lines),
+    pad (overlap lines a block needs either side), aperture (lines of the processed band).
     """
-    if raw.orbit is None or raw.orbit.frame not in ("ECI", "ECEF"):
-        return np.zeros_like(r0), np.zeros_like(r0)
-    from orbit.errors import GeometryError
-    from orbit.geometry import doppler_time, geolocate
-    from sarcli.focus.geolocation import state_vectors
 
-    sv = state_vectors(raw.orbit, raw.epoch_utc)
-    idx = np.unique(np.r_[np.arange(0, r0.size, step), r0.size - 1])
-    rc = r0[idx] / np.sqrt(1.0 - s[idx] ** 2)
-    try:
-        p = geolocate(sv, np.full(idx.size, t), rc, wavelength, fdc[idx], _reference_height(raw), raw.look_side)
-        t_zd, r0_true = doppler_time(sv, p, t_guess=t)
-    except GeometryError as e:
-        raise SarcliError(f"orbit timing correction failed ({e}); use orbit_timing=False") from None
-    delta_model = beam_centre_offset(r0[idx], v[idx], s[idx])
-    grid = np.arange(r0.size)
-    dt = np.interp(grid, idx, delta_model - (t - t_zd))
-    ph0 = np.interp(grid, idx, 4.0 * np.pi * (r0[idx] - r0_true) / wavelength)
-    return dt, ph0
-
-
-@dataclass
-class _Plan:
     prf: float
     ranges: np.ndarray
     wavelength: float
     ba: float
     shift: int
+    offsets: np.ndarray
     pad: int
-    n_fft_az: int
-    n_valid: int
-    n_fft_r: int
-    full_aperture: float
+    aperture: float
+
+    def zero_doppler_times(self, t_raw: np.ndarray) -> np.ndarray:
+        """Zero-Doppler time of every output line (s after the epoch)."""
+        return t_raw[0] + (np.arange(t_raw.size) - self.shift) / self.prf
+
+    def full_lines(self, n_lines: int) -> tuple[int, int]:
+        """(first_full_line, last_full_line): lines that see the whole processed aperture."""
+        first = int(math.ceil(0.5 * self.aperture))
+        return first, n_lines - 1 - first
 
 
-def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan:
+def plan_grid(raw: RawProduct, shape: tuple[int, int], doppler, azimuth_bandwidth_hz: float | None) -> OutputGrid:
+    """The output grid of a stripmap focuser (see :class:`OutputGrid`), from the model at the scene's
+    start, centre and end (the overlap must hold the aperture and the drift of the beam-centre offset)."""
     radar = raw.radar
-    n_lines = shape[0]
     prf = _uniform_prf(raw.azimuth_time, radar.prf_hz)
     ranges = radar.first_range_m + np.arange(shape[1]) * C / (2.0 * radar.range_sampling_rate_hz)
     lam = C / radar.carrier_frequency_hz
-    ba = 0.8 * prf if k.azimuth_bandwidth_hz is None else float(k.azimuth_bandwidth_hz)
+    ba = 0.8 * prf if azimuth_bandwidth_hz is None else float(azimuth_bandwidth_hz)
     if not 0.0 < ba <= prf:
-        raise SarcliError(f"azimuth bandwidth {ba:.4g} Hz must be in (0, PRF = {prf:.4g} Hz]")
+        raise ConfigError(f"azimuth bandwidth {ba:.4g} Hz must be in (0, PRF = {prf:.4g} Hz]")
     t = raw.azimuth_time
     offsets, fr_abs = [], []
     for tb in (t[0], 0.5 * (t[0] + t[-1]), t[-1]):
@@ -251,13 +258,454 @@ def _plan(raw: RawProduct, shape: tuple[int, int], doppler, k: RdKnobs) -> _Plan
     shift = int(round(float(offsets[1][mid])))
     resid = max(float(np.max(np.abs(o - shift))) for o in offsets)
     aperture = float(np.max(aperture_time(np.min(fr_abs, axis=0), ba))) * prf
-    pad = int(math.ceil(0.5 * aperture + resid)) + 4
-    n_fft_az = smooth_len(max(k.block_lines, 4 * pad) if n_lines + 2 * pad > k.block_lines
-                          else n_lines + 2 * pad)
-    n_valid = min(n_lines, n_fft_az - 2 * pad)
-    n_ref = reference_pulse(radar, raw.replica if k.use_replica else None).size
-    n_fft_r = smooth_len(len(ranges) + n_ref // 2 + RANGE_GUARD)
-    return _Plan(prf, ranges, lam, ba, shift, pad, n_fft_az, n_valid, n_fft_r, aperture)
+    # + 4 lines of margin, + 8 for the reach of the per-line shift interpolator (16 taps)
+    pad = int(math.ceil(0.5 * aperture + resid)) + 4 + 8
+    return OutputGrid(prf, ranges, lam, ba, shift, offsets[1], pad, aperture)
+
+
+def orbit_time_correction(raw: RawProduct, t, r0: np.ndarray, fdc: np.ndarray, v: np.ndarray, s: np.ndarray,
+                          wavelength: float, terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
+    """Orbit corrections of the hyperbolic model at raw times ``t`` (broadcast with the other arrays):
+    (time shift dt s, phase ph0 rad).
+
+    The RDA puts a target seen at beam-centre time t at ``t - Delta_model``, Delta_model = R0 tan(theta)/V,
+    with phase -4 pi R0_model / lam, R0_model = R_c cos(theta). With a squint of several PRFs Delta is
+    seconds long and the hyperbola, fitted to fdc and fr at the beam centre, misplaces the zero-Doppler
+    time by a fraction of a line (0.17 line for the Radarsat-1 sample) and the closest range by
+    millimetres (2 rad of phase). With an Earth orbit the target seen at (t, R_c = R0/cos(theta), fdc)
+    is geolocated on the terrain (:func:`sarcli.focus.geolocation.geolocate_on_terrain`) and its exact
+    zero-Doppler time t_zd and closest range R0_true solved (``orbit.geometry``):
+    dt = Delta_model - (t - t_zd) and ph0 = 4 pi (R0 - R0_true) / lam. Zeros without an Earth orbit.
+    """
+    r0, t, fdc, v, s = np.broadcast_arrays(np.asarray(r0, np.float64), np.asarray(t, np.float64), fdc, v, s)
+    if raw.orbit is None or raw.orbit.frame not in ("ECI", "ECEF"):
+        return np.zeros(r0.shape), np.zeros(r0.shape)
+    from orbit.errors import GeometryError
+    from orbit.geometry import doppler_time
+    from sarcli.focus.geolocation import geolocate_on_terrain, state_vectors
+
+    sv = state_vectors(raw.orbit, raw.epoch_utc)
+    rc = r0 / np.sqrt(1.0 - s**2)
+    try:
+        p = geolocate_on_terrain(sv, t, rc, wavelength, fdc, raw.look_side, terrain)
+        t_zd, r0_true = doppler_time(sv, p, t_guess=t)
+    except GeometryError as e:
+        raise SarcliError(f"orbit timing correction failed ({e}); use orbit_timing=False") from None
+    delta_model = beam_centre_offset(r0, v, s)
+    return delta_model - (t - t_zd), 4.0 * np.pi * (r0 - r0_true) / wavelength
+
+
+@dataclass(frozen=True)
+class ModelGrid:
+    """The Doppler model and the orbit-timing correction on the plan's fixed (time, range) grid.
+
+    ``times`` (n_t,) raw times s, ``columns`` (n_r,) output columns; arrays (n_t, n_r): fdc (Hz),
+    fr (Hz/s), v (effective velocity m/s), s (sin squint), dt (s), ph0 (rad). Linear in time and
+    range between nodes (module docstring).
+    """
+
+    times: np.ndarray
+    columns: np.ndarray
+    fdc: np.ndarray
+    fr: np.ndarray
+    v: np.ndarray
+    s: np.ndarray
+    dt: np.ndarray
+    ph0: np.ndarray
+
+    def at(self, t: float) -> dict[str, np.ndarray]:
+        """Every quantity at time ``t`` on the grid's columns, (n_r,) each."""
+        return self.at_nodes(np.full(self.columns.size, float(t)))
+
+    def at_nodes(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Every quantity at times ``t`` (n_t, n_r) on the grid's own columns (one time per node column)."""
+        tt = np.asarray(t, np.float64)
+        x = np.clip((tt - self.times[0]) / (self.times[1] - self.times[0]) if self.times.size > 1 else 0 * tt,
+                    0.0, self.times.size - 1.0)
+        k = np.minimum(np.floor(x).astype(np.int64), max(self.times.size - 2, 0))
+        w = x - k
+        k1 = np.minimum(k + 1, self.times.size - 1)
+        j = np.broadcast_to(np.arange(self.columns.size), tt.shape)
+        return {n: (1.0 - w) * a[k, j] + w * a[k1, j] for n, a in
+                (("fdc", self.fdc), ("fr", self.fr), ("v", self.v), ("s", self.s), ("dt", self.dt),
+                 ("ph0", self.ph0))}
+
+    def at_columns(self, t: float, n_cols: int) -> dict[str, np.ndarray]:
+        """Every quantity at time t on every output column 0..n_cols-1 (linear along range)."""
+        q = self.at(float(t))
+        cols = np.arange(n_cols)
+        return {n: np.interp(cols, self.columns, a) for n, a in q.items()}
+
+
+def model_grid(raw: RawProduct, doppler, grid: OutputGrid, orbit_timing: bool, terrain: Terrain) -> ModelGrid:
+    """Evaluate the model on the fixed grid covering every block centre and every output line's beam-centre
+    time (raw times t_raw[j] + (offset - shift) / PRF)."""
+    t = raw.azimuth_time
+    nr = grid.ranges.size
+    cols = np.unique(np.r_[np.arange(0, nr, GRID_SAMPLES), nr - 1])
+    step = GRID_LINES / grid.prf
+    lo = float(t[0] + min(0.0, float(np.min(grid.offsets)) - grid.shift) / grid.prf) - step
+    hi = float(t[-1] + max(0.0, float(np.max(grid.offsets)) - grid.shift) / grid.prf) + step
+    # nodes at t[0] + k step: the same nodes whatever the block layout
+    k0, k1 = math.floor((lo - t[0]) / step), math.ceil((hi - t[0]) / step)
+    times = t[0] + np.arange(k0, k1 + 1) * step
+    r0 = np.broadcast_to(grid.ranges[cols][None, :], (times.size, cols.size))
+    tt = np.broadcast_to(times[:, None], r0.shape)
+    fdc, fr, v, s = doppler_on_grid(doppler, r0, tt, grid.wavelength)
+    if orbit_timing:
+        dt, ph0 = orbit_time_correction(raw, tt, r0, fdc, v, s, grid.wavelength, terrain)
+    else:
+        dt, ph0 = np.zeros(r0.shape), np.zeros(r0.shape)
+    return ModelGrid(times, cols, fdc, fr, v, s, dt, ph0)
+
+
+def _migration_terms(f: np.ndarray, v: np.ndarray, wavelength: float) -> tuple[np.ndarray, np.ndarray]:
+    """(x, D) with x = (lam f / 2V)^2 and D = sqrt(1 - x)."""
+    x = (wavelength * f / (2.0 * v)) ** 2
+    return x, np.sqrt(1.0 - x)
+
+
+def velocity_correction(r0: np.ndarray, f_c: np.ndarray, v_block: np.ndarray, v_line: np.ndarray,
+                        wavelength: float) -> tuple[np.ndarray, np.ndarray]:
+    """(phase rad to ADD at the peak, time s the peak lands late) of a target focused with velocity
+    ``v_block`` whose own is ``v_line`` (band centre ``f_c``, closest range ``r0``).
+
+    The target's spectrum carries -4 pi R0 D(f, V_line) / lam - 2 pi f eta0; the filter removes
+    -4 pi R0 D(f, V_block) / lam, leaving E(f) = (4 pi R0 / lam)(D(f, V_block) - D(f, V_line)).
+    Linearized at the band centre f_c, E = E0 + E1 (f - f_c): the image of the target is
+    exp(j (E0 - E1 f_c)) G(eta - eta0 + E1 / 2 pi) with G peaking at 0 with phase 0 (the inverse FFT
+    of exp(j E1 f) is a shift), so the peak lands -E1 / 2 pi late with its phase off by E0 - E1 f_c;
+    the phase correction is the negative of that. E0 = K (x_l - x_b) / (D_b + D_l) (no
+    cancellation), K = 4 pi R0 / lam, x, D of :func:`_migration_terms`; dD/df = -(lam / 2V)^2 f / D.
+    The curvature E2 is left: |E2| Ba^2 / 12 of phase (2e-3 rad for 0.05 m/s at Radarsat-1's squint).
+    """
+    k = 4.0 * np.pi * r0 / wavelength
+    xb, db = _migration_terms(f_c, v_block, wavelength)
+    xl, dl = _migration_terms(f_c, v_line, wavelength)
+    e0 = k * (xl - xb) / (db + dl)
+    e1 = k * f_c * ((wavelength / (2.0 * v_line)) ** 2 / dl - (wavelength / (2.0 * v_block)) ** 2 / db)
+    return -(e0 - e1 * f_c), -e1 / (2.0 * np.pi)
+
+
+@njit(parallel=True, cache=True)
+def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, table):
+    """out[j, i] = exp(j phi) s_i(pad + j + mu): column i of ``img`` (azimuth samples of a signal around
+    ``carrier[i]`` cycles per line, the ABSOLUTE centroid / PRF) interpolated at a fractional line,
+    then rotated; phi (rad) and mu (lines) bilinear between the coarse lines ``lines_c`` (global line
+    numbers, ``first`` is output line 0) and columns ``cols_c``.
+
+    Band-pass interpolation: s(p) = sum_m s[m] h(p - m) exp(j 2 pi c (p - m)) with the windowed-sinc
+    table ``table`` (:mod:`sarcli.focus.interp`) for h: the carrier phase is kept as the absolute
+    frequency dictates (the same shift in the frequency domain is exp(-j 2 pi f dt) with the absolute f).
+    Per pixel: one sine/cosine and ``taps`` complex multiply-adds.
+    """
+    n_out, nr = out.shape
+    n_in = img.shape[0]
+    nph = table.shape[0] - 1
+    taps = table.shape[1]
+    k0 = taps // 2 - 1
+    nl = lines_c.shape[0]
+    nc = cols_c.shape[0]
+    for j in prange(n_out):
+        line = first + j
+        k = 0
+        while k < nl - 2 and lines_c[k + 1] <= line:
+            k += 1
+        w = (line - lines_c[k]) / (lines_c[k + 1] - lines_c[k])
+        for c in range(nc - 1):
+            a0 = (1.0 - w) * phi_c[k, c] + w * phi_c[k + 1, c]
+            a1 = (1.0 - w) * phi_c[k, c + 1] + w * phi_c[k + 1, c + 1]
+            m0 = (1.0 - w) * mu_c[k, c] + w * mu_c[k + 1, c]
+            m1 = (1.0 - w) * mu_c[k, c + 1] + w * mu_c[k + 1, c + 1]
+            i0 = cols_c[c]
+            i1 = cols_c[c + 1]
+            stop = i1 if c < nc - 2 else i1 + 1
+            for i in range(i0, stop):
+                t = (i - i0) / (i1 - i0)
+                p = pad + j + m0 + (m1 - m0) * t
+                n0 = int(np.floor(p))
+                frac = p - n0
+                jp = int(frac * nph + 0.5)
+                b = n0 - k0
+                cyc = carrier[i]
+                # exp(j 2 pi c (p - m)) for m = b + tap: start at tap 0, rotate by exp(-j 2 pi c) per tap
+                ang = a0 + (a1 - a0) * t + 2.0 * np.pi * cyc * (p - b)
+                cur = complex(np.cos(ang), np.sin(ang))
+                rot = complex(np.cos(2.0 * np.pi * cyc), -np.sin(2.0 * np.pi * cyc))
+                acc = 0.0j
+                for tap in range(taps):
+                    m = b + tap
+                    if 0 <= m < n_in:
+                        acc += img[m, i] * (table[jp, tap] * cur)
+                    cur *= rot
+                out[j, i] = acc
+
+
+def correct_lines_numpy(img: np.ndarray, pad: int, first: int, n_out: int, lines_c: np.ndarray, cols_c: np.ndarray,
+                        phi_c: np.ndarray, mu_c: np.ndarray, carrier: np.ndarray, interpolator: str) -> np.ndarray:
+    """Plain-numpy reference of :func:`correct_lines` (exact windowed-sinc weights)."""
+    from sarcli.focus.interp import sinc_weights
+
+    lines = first + np.arange(n_out)
+    cols = np.arange(img.shape[1])
+
+    def grid(v):
+        by_col = np.stack([np.interp(lines, lines_c, v[:, c]) for c in range(cols_c.size)], axis=1)
+        return np.stack([np.interp(cols, cols_c, row) for row in by_col])
+
+    phi, mu = grid(phi_c), grid(mu_c)
+    taps = int(interpolator[4:])
+    p = pad + np.arange(n_out)[:, None] + mu
+    n0 = np.floor(p).astype(int)
+    wts = sinc_weights(taps, p - n0)
+    out = np.zeros((n_out, img.shape[1]), complex)
+    for tap in range(taps):
+        m = n0 - (taps // 2 - 1) + tap
+        ok = (m >= 0) & (m < img.shape[0])
+        val = img[np.clip(m, 0, img.shape[0] - 1), cols[None, :]]
+        out += np.where(ok, val * wts[..., tap] * np.exp(2j * np.pi * carrier[None, :] * (p - m)), 0)
+    return out * np.exp(1j * phi)
+
+
+@njit(parallel=True, cache=True)
+def apply_line_phase(out, first, lines_c, cols_c, phi_c):
+    """out[j, i] *= exp(j phi(first + j, i)), phi linear between the coarse lines ``lines_c`` and columns
+    ``cols_c`` where it is given (``phi_c`` (n_lines_c, n_cols_c); at least two of each, covering the
+    block's lines and every column); in place.
+
+    Along range the phasor advances by a constant rotation between coarse columns (one complex multiply
+    per pixel; phi is linear there, so the recurrence is exact up to round-off: < 1e-12 rad over a span).
+    """
+    n = out.shape[0]
+    nl = lines_c.shape[0]
+    nc = cols_c.shape[0]
+    for j in prange(n):
+        line = first + j
+        k = 0
+        while k < nl - 2 and lines_c[k + 1] <= line:
+            k += 1
+        w = (line - lines_c[k]) / (lines_c[k + 1] - lines_c[k])
+        for c in range(nc - 1):
+            a0 = (1.0 - w) * phi_c[k, c] + w * phi_c[k + 1, c]
+            a1 = (1.0 - w) * phi_c[k, c + 1] + w * phi_c[k + 1, c + 1]
+            i0 = cols_c[c]
+            i1 = cols_c[c + 1]
+            step = (a1 - a0) / (i1 - i0)
+            cur = complex(np.cos(a0), np.sin(a0))
+            rot = complex(np.cos(step), np.sin(step))
+            stop = i1 if c < nc - 2 else i1 + 1
+            for i in range(i0, stop):
+                out[j, i] *= cur
+                cur *= rot
+
+
+def apply_line_phase_numpy(out: np.ndarray, first: int, lines_c: np.ndarray, cols_c: np.ndarray,
+                           phi_c: np.ndarray) -> np.ndarray:
+    """Plain-numpy reference of :func:`apply_line_phase` (returns the corrected copy)."""
+    lines = first + np.arange(out.shape[0])
+    by_col = np.stack([np.interp(lines, lines_c, phi_c[:, c]) for c in range(cols_c.size)], axis=1)
+    phi = np.stack([np.interp(np.arange(out.shape[1]), cols_c, row) for row in by_col])
+    return out * np.exp(1j * phi)
+
+
+@dataclass
+class RdPlan:
+    """Everything the RD blocks share (:meth:`RangeDoppler.plan`); read-only while blocks run, except
+    ``timings`` (seconds per stage, accumulated by the blocks: diagnostics only)."""
+
+    raw: RawProduct
+    options: RdOptions
+    terrain: Terrain
+    grid: OutputGrid
+    model: ModelGrid
+    output_shape: tuple[int, int]
+    n_blocks: int
+    n_valid: int
+    n_fft_az: int
+    n_fft_r: int
+    h: np.ndarray
+    wtab: np.ndarray
+    kind: int
+    table: np.ndarray
+    f_bin: np.ndarray
+    shift_table: np.ndarray
+    gain: np.ndarray | None
+    block_time: np.ndarray
+    block: list[dict[str, np.ndarray]]
+    warnings: list[str]
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def block_rows(self, b: int) -> tuple[int, int]:
+        s = b * self.n_valid
+        return s, min(s + self.n_valid, self.output_shape[0])
+
+
+class RangeDoppler:
+    """The RDA as a focuser (:mod:`sarcli.focus.base`): ``sarcli focus --algorithm rd``."""
+
+    name = "rd"
+    Options = RdOptions
+    streams = True
+    needs_doppler = True
+
+    def plan(self, raw: RawProduct, shape: tuple[int, int], doppler, options: RdOptions,
+             terrain: Terrain) -> RdPlan:
+        k = options
+        n_lines, nr = shape
+        if n_lines < 2:
+            raise SarcliError("the scene has fewer than two azimuth lines: nothing to focus")
+        if nr < 2:
+            raise SarcliError("the scene has fewer than two range samples: nothing to focus")
+        t0 = time.perf_counter()
+        grid = plan_grid(raw, shape, doppler, k.azimuth_bandwidth_hz)
+        pad = grid.pad
+        n_fft_az = smooth_len(max(k.block_lines, 4 * pad) if n_lines + 2 * pad > k.block_lines
+                              else n_lines + 2 * pad)
+        n_valid = min(n_lines, n_fft_az - 2 * pad)
+        n_ref = reference_pulse(raw.radar, raw.replica if k.use_replica else None).size
+        n_fft_r = smooth_len(nr + n_ref // 2 + RANGE_GUARD)
+        cdt = np.complex64 if k.precision == "single" else np.complex128
+        h, _ = range_filter(raw.radar, n_fft_r, k.range_window, raw.replica if k.use_replica else None,
+                            k.range_bandwidth_fraction)
+        kind, table = table_for(k.rcmc)
+        model = model_grid(raw, doppler, grid, k.orbit_timing, terrain)
+        n_blocks = int(math.ceil(n_lines / n_valid))
+        t_raw = raw.azimuth_time
+        block_time = np.array([t_raw[0] + 0.5 * (b * n_valid + min((b + 1) * n_valid, n_lines) - 1) / grid.prf
+                               for b in range(n_blocks)])
+        blocks = [model.at_columns(tb, nr) for tb in block_time]
+        msgs = _coverage_warnings(doppler, grid.ranges, t_raw)
+        first_full, last_full = grid.full_lines(n_lines)
+        if first_full > last_full:
+            msgs.append(f"scene ({n_lines} lines) is shorter than the synthetic aperture ({grid.aperture:.0f} lines):"
+                        " no line is fully focused")
+        for m in msgs:
+            warnings.warn(m, stacklevel=2)
+        return RdPlan(raw=raw, options=k, terrain=terrain, grid=grid, model=model, output_shape=(n_lines, nr),
+                      n_blocks=n_blocks, n_valid=n_valid, n_fft_az=n_fft_az, n_fft_r=n_fft_r, h=h.astype(cdt),
+                      wtab=window_table(k.azimuth_window), kind=kind,
+                      table=table.astype(np.float32 if k.precision == "single" else np.float64),
+                      f_bin=sfft.fftfreq(n_fft_az, 1.0 / grid.prf),
+                      shift_table=table_for(SHIFT_INTERPOLATOR)[1].astype(np.float32 if k.precision == "single"
+                                                                           else np.float64),
+                      gain=raw.line_gain(), block_time=block_time,
+                      block=blocks, warnings=msgs, timings={"plan_s": time.perf_counter() - t0})
+
+    def focus_block(self, plan: RdPlan, b: int, read_lines: Callable[[int, int], np.ndarray]) -> np.ndarray:
+        k, g, raw = plan.options, plan.grid, plan.raw
+        n_lines, nr = plan.output_shape
+        s, e = plan.block_rows(b)
+        a, z = max(0, s - g.pad), min(n_lines, e + g.pad)
+        tm = plan.timings
+        t0 = time.perf_counter()
+        data = np.asarray(read_lines(a, z))
+        _add(tm, "io_s", t0)
+        if data.shape != (z - a, nr):
+            raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
+        t0 = time.perf_counter()
+        y = np.empty((plan.n_fft_az, plan.n_fft_r), plan.h.dtype)
+        _range_rows(y, a - (s - g.pad), data, None if plan.gain is None else plan.gain[a:z], k.workers)
+        del data
+        _add(tm, "range_fft_s", t0)
+        t0 = time.perf_counter()
+        _fft_inplace(y, 0, False, k.workers)
+        _add(tm, "azimuth_fft_s", t0)
+        q = plan.block[b]
+        inv_k = np.zeros(plan.n_fft_az)
+        if k.src:
+            mid = nr // 2
+            off_f = plan.f_bin - q["fdc"][mid]
+            f_abs = q["fdc"][mid] + off_f - g.prf * np.floor(off_f / g.prf + 0.5)
+            inv_k = inverse_src_rate(f_abs, float(g.ranges[mid]), float(q["v"][mid]), raw.radar.carrier_frequency_hz)
+        t0 = time.perf_counter()
+        _filter_rcmc_rows(y, nr, plan.h, inv_k, plan.f_bin, g, raw.radar.range_sampling_rate_hz, k.rcmc_oversample,
+                          q["v"], q["fdc"], q["dt"], q["ph0"], plan.wtab, plan.kind, plan.table, k.workers)
+        _add(tm, "range_filter_rcmc_azimuth_s", t0)
+        img = y[:, :nr]
+        t0 = time.perf_counter()
+        _fft_inplace(img, 0, True, k.workers)
+        _add(tm, "azimuth_ifft_s", t0)
+        out = img[g.pad:g.pad + (e - s)]
+        t0 = time.perf_counter()
+        lines_c, phi, mu = self.line_corrections(plan, b)
+        if np.max(np.abs(mu)) >= SHIFT_TOL_LINES:
+            shifted = np.empty((e - s, nr), img.dtype)
+            correct_lines(img, g.pad, s, shifted, lines_c, plan.model.columns, phi, mu, q["fdc"] / g.prf,
+                          plan.shift_table)
+            out = shifted
+        elif np.any(phi != 0.0):
+            apply_line_phase(out, s, lines_c, plan.model.columns, phi)
+        _add(tm, "line_correction_s", t0)
+        return out.astype(np.complex64, copy=False)
+
+    @staticmethod
+    def line_corrections(plan: RdPlan, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(coarse lines, phase rad, shift lines), the last two (n_lines_c, n_columns_c), that block
+        ``b``'s output lines need: from the block's model (time ``block_time[b]``) to the model at each
+        line's beam-centre time t_c = t_raw[0] + (line + offset - shift) / PRF. Velocity
+        (:func:`velocity_correction`) and orbit timing: phase ph0(t_c) - ph0_block, and the target,
+        placed dt_block - dt(t_c) late by the block's time shift, is taken from there. Zero at the block
+        centre; exactly zero for a model that does not vary in time."""
+        g, m = plan.grid, plan.model
+        s, e = plan.block_rows(b)
+        lines_c = np.r_[np.arange(s, e, CORRECTION_LINES), e].astype(np.int64)
+        # the beam-centre time of the target on each line: zero-Doppler time + Delta(t_c), a fixed point
+        # (two steps from the scene-centre offsets: Delta moves by R0 d(theta) / V, ~30 lines per 40 Hz of
+        # centroid change at 850 km, and that time error would reach the velocity correction)
+        t_zd = plan.raw.azimuth_time[0] + (lines_c[:, None] - g.shift) / g.prf
+        r0 = g.ranges[m.columns][None, :]
+        tc = t_zd + g.offsets[m.columns][None, :] / g.prf
+        for _ in range(2):
+            q = m.at_nodes(np.broadcast_to(tc, (lines_c.size, m.columns.size)))
+            tc = t_zd + beam_centre_offset(r0, q["v"], q["s"])
+        line = m.at_nodes(np.broadcast_to(tc, (lines_c.size, m.columns.size)))
+        blk = m.at(float(plan.block_time[b]))
+        fdc_b = plan.block[b]["fdc"][m.columns]
+        phi, late = velocity_correction(r0, fdc_b[None, :], blk["v"][None, :], line["v"], g.wavelength)
+        phi = phi + (line["ph0"] - blk["ph0"][None, :])
+        mu = (late + blk["dt"][None, :] - line["dt"]) * g.prf
+        return lines_c, np.ascontiguousarray(phi, np.float64), np.ascontiguousarray(mu, np.float64)
+
+    def finish(self, plan: RdPlan) -> SLC:
+        g, raw, k = plan.grid, plan.raw, plan.options
+        n_lines, nr = plan.output_shape
+        first_full, last_full = g.full_lines(n_lines)
+        fdcs = np.array([q["fdc"] for q in plan.block])
+        frs = np.array([q["fr"] for q in plan.block])
+        vs = np.array([q["v"] for q in plan.block])
+        dts = np.array([q["dt"] for q in plan.block])
+        params = {"algorithm": self.name, **to_mapping(k, keep_none=True), "azimuth_bandwidth_hz": g.ba,
+                  "prf_hz": g.prf, "shift_lines": g.shift, "overlap_lines": g.pad, "azimuth_fft_length": plan.n_fft_az,
+                  "block_output_lines": plan.n_valid, "range_fft_length": plan.n_fft_r, "n_blocks": plan.n_blocks,
+                  "aperture_lines": g.aperture, "orbit_timing_correction_max_s": float(np.max(np.abs(dts))),
+                  "model_grid_lines": GRID_LINES, "model_grid_samples": GRID_SAMPLES,
+                  "replica_used": bool(k.use_replica and raw.replica is not None and np.size(raw.replica) > 1),
+                  "terrain": plan.terrain.describe(), "warnings": plan.warnings}
+        return SLC.from_raw(raw, image=np.zeros((0, 0), np.complex64),
+                            azimuth_time=g.zero_doppler_times(raw.azimuth_time), slant_range=g.ranges.copy(),
+                            doppler=DopplerUsed(plan.block_time.copy(), g.ranges.copy(), fdcs, frs, vs),
+                            algorithm=self.name, azimuth_spacing_m=float(np.median(vs[:, nr // 2])) / g.prf,
+                            first_full_line=first_full, last_full_line=last_full, parameters=params,
+                            timings=dict(plan.timings))
+
+
+RD = RangeDoppler()
+
+
+def _add(timings: dict[str, float], key: str, t0: float) -> None:
+    timings[key] = timings.get(key, 0.0) + time.perf_counter() - t0
+
+
+def focus_rd(raw: RawProduct, doppler, channel: int = 0, terrain: Terrain | None = None, **options: Any) -> SLC:
+    """Focus one receive channel of an in-memory raw product with the RDA.
+
+    ``doppler``: any object with vectorized ``fdc(range_m, t)`` and ``fr(range_m, t)``; ``options``: the
+    fields of :class:`RdOptions`; ``terrain``: the ground (default 0 m above the ellipsoid).
+    Returns an :class:`sarcli.model.slc.SLC` with zero-Doppler times and slant ranges.
+    """
+    from sarcli.focus.base import focus_in_memory
+
+    return focus_in_memory(RD, raw, doppler, options, terrain or ConstantHeight(0.0), channel)
 
 
 def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int, cols: int = 256) -> None:
@@ -363,127 +811,3 @@ def _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, fs, factor, v, fdc, dt, ph0, wt
     _pooled(chunks, run, workers)
 
 
-def focus_stream(raw: RawProduct, read_lines: Callable[[int, int], np.ndarray],
-                 sink: Callable[[int, np.ndarray], None], doppler, knobs: RdKnobs,
-                 shape: tuple[int, int], on_block: Callable[[int, int], None] | None = None) -> SLC:
-    """Focus lines read by ``read_lines(a, b)`` and hand output blocks to ``sink(first_line, block)``.
-
-    ``raw`` supplies metadata (its echo may be empty), ``shape`` = (n_lines, n_samples) of the echo;
-    returns the SLC metadata with an empty image.
-    """
-    k = knobs
-    t_start = time.perf_counter()
-    timings = {"range_fft_s": 0.0, "azimuth_fft_s": 0.0, "range_filter_rcmc_azimuth_s": 0.0,
-               "azimuth_ifft_s": 0.0, "io_s": 0.0}
-    radar = raw.radar
-    n_lines = shape[0]
-    if n_lines < 2:
-        raise SarcliError("the scene has fewer than two azimuth lines: nothing to focus")
-    p = _plan(raw, shape, doppler, k)
-    nr = p.ranges.size
-    cdt = np.complex64 if k.precision == "single" else np.complex128
-    h, _ = range_filter(radar, p.n_fft_r, k.range_window, raw.replica if k.use_replica else None,
-                        k.range_bandwidth_fraction)
-    h = h.astype(cdt)
-    wtab = window_table(k.azimuth_window)
-    kind, table = table_for(k.rcmc)
-    table = table.astype(np.float32 if k.precision == "single" else np.float64)  # single: complex64 taps
-    f_bin = sfft.fftfreq(p.n_fft_az, 1.0 / p.prf)
-    gain = raw.line_gain()
-    t_raw = raw.azimuth_time
-    dt = 1.0 / p.prf
-    msgs = _coverage_warnings(doppler, p.ranges, t_raw)
-    first_full = int(math.ceil(0.5 * p.full_aperture))
-    last_full = n_lines - 1 - first_full
-    if first_full > last_full:
-        msgs.append(f"scene ({n_lines} lines) is shorter than the synthetic aperture ({p.full_aperture:.0f} lines):"
-                    " no line is fully focused")
-    for m in msgs:
-        warnings.warn(m, stacklevel=2)
-    r_mid = float(p.ranges[nr // 2])
-    block_times, fdcs, frs, vs, dts = [], [], [], [], []
-    n_blocks = int(math.ceil(n_lines / p.n_valid))
-    for b in range(n_blocks):
-        s = b * p.n_valid
-        e = min(s + p.n_valid, n_lines)
-        a, z = max(0, s - p.pad), min(n_lines, e + p.pad)
-        t0 = time.perf_counter()
-        data = np.asarray(read_lines(a, z))
-        timings["io_s"] += time.perf_counter() - t0
-        if data.shape != (z - a, nr):
-            raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
-        t0 = time.perf_counter()
-        y = np.empty((p.n_fft_az, p.n_fft_r), cdt)
-        _range_rows(y, a - (s - p.pad), data, None if gain is None else gain[a:z], k.workers)
-        del data
-        timings["range_fft_s"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        _fft_inplace(y, 0, False, k.workers)
-        timings["azimuth_fft_s"] += time.perf_counter() - t0
-        tb = float(t_raw[0] + 0.5 * (s + e - 1) * dt)
-        fdc, fr, v, sq = doppler_on_grid(doppler, p.ranges, tb, p.wavelength)
-        dt_orbit, ph_orbit = (orbit_time_correction(raw, tb, p.ranges, fdc, v, sq, p.wavelength)
-                              if k.orbit_timing else (np.zeros(nr), np.zeros(nr)))
-        block_times.append(tb)
-        fdcs.append(fdc)
-        frs.append(fr)
-        vs.append(v)
-        dts.append(dt_orbit)
-        inv_k = np.zeros(p.n_fft_az)
-        if k.src:
-            off_f = f_bin - fdc[nr // 2]
-            f_abs = fdc[nr // 2] + off_f - p.prf * np.floor(off_f / p.prf + 0.5)
-            inv_k = inverse_src_rate(f_abs, r_mid, float(v[nr // 2]), radar.carrier_frequency_hz)
-        t0 = time.perf_counter()
-        _filter_rcmc_rows(y, nr, h, inv_k, f_bin, p, radar.range_sampling_rate_hz, k.rcmc_oversample, v, fdc,
-                          dt_orbit, ph_orbit, wtab, kind, table, k.workers)
-        timings["range_filter_rcmc_azimuth_s"] += time.perf_counter() - t0
-        img = y[:, :nr]
-        t0 = time.perf_counter()
-        _fft_inplace(img, 0, True, k.workers)
-        timings["azimuth_ifft_s"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        sink(s, img[p.pad:p.pad + (e - s)].astype(np.complex64, copy=False))
-        timings["io_s"] += time.perf_counter() - t0
-        if on_block is not None:
-            on_block(b + 1, n_blocks)
-    timings["total_s"] = time.perf_counter() - t_start
-    v_mid = float(np.median(np.asarray(vs)[:, nr // 2]))
-    params = {"algorithm": "rd", **asdict(k), "azimuth_bandwidth_hz": p.ba, "prf_hz": p.prf,
-              "shift_lines": p.shift, "overlap_lines": p.pad, "azimuth_fft_length": p.n_fft_az,
-              "range_fft_length": p.n_fft_r, "n_blocks": n_blocks, "aperture_lines": p.full_aperture,
-              "orbit_timing_correction_max_s": float(np.max(np.abs(dts))),
-              "replica_used": bool(k.use_replica and raw.replica is not None and np.size(raw.replica) > 1),
-              "warnings": msgs}
-    return SLC(
-        image=np.zeros((0, 0), np.complex64),
-        azimuth_time=t_raw[0] + (np.arange(n_lines) - p.shift) * dt,
-        slant_range=p.ranges.copy(), epoch_utc=raw.epoch_utc, radar=radar,
-        doppler=DopplerUsed(np.asarray(block_times), p.ranges.copy(), np.asarray(fdcs), np.asarray(frs),
-                            np.asarray(vs)),
-        look_side=raw.look_side, source=raw.source, algorithm="rd",
-        azimuth_spacing_m=v_mid / p.prf, first_full_line=first_full, last_full_line=last_full,
-        parameters=params, timings=timings, orbit=raw.orbit, attitude=raw.attitude, truth=raw.truth,
-    )
-
-
-def focus_rd(raw: RawProduct, doppler, channel: int = 0, **knobs) -> SLC:
-    """Focus one receive channel of an in-memory raw product with the RDA (contract 5).
-
-    ``doppler``: any object with vectorized ``fdc(range_m, t)`` and ``fr(range_m, t)``. Knobs: see
-    :class:`RdKnobs`. Returns an :class:`sarcli.io.slc.SLC` with zero-Doppler times and slant ranges.
-    """
-    k = make_knobs(**knobs)
-    echo = raw.channel(channel)
-    n_lines, nr = echo.shape
-    out = np.empty((n_lines, nr), np.complex64)  # the blocks cover every line
-
-    def sink(s: int, block: np.ndarray) -> None:
-        def put(c: int, d: int) -> None:  # first touch of the output's pages, shared by the threads
-            out[s + c:s + d] = block[c:d]
-
-        _pooled([(c, min(c + 256, block.shape[0])) for c in range(0, block.shape[0], 256)], put, k.workers)
-
-    slc = focus_stream(raw, lambda a, b: echo[a:b], sink, doppler, k, (n_lines, nr))
-    slc.image = out
-    return slc

@@ -88,6 +88,8 @@ def to_jsonable(obj: Any) -> Any:
         return obj if np.isfinite(obj) else None
     if isinstance(obj, os.PathLike):
         return str(obj)
+    if isinstance(obj, bytes):  # HDF5 fixed-length strings (NISAR/CF attributes)
+        return obj.decode("utf-8", errors="replace")
     return obj
 
 

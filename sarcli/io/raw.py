@@ -23,8 +23,11 @@ Layout (all SI; see ``docs/products.md``)::
       position             float64 (n, 3) m
       velocity             float64 (n, 3) m/s
     /attitude              optional group: time (s), pitch, roll, yaw (rad, float64)
-    /auxiliary             optional group: named arrays a reader keeps beside the echo
-                           (RawProduct.auxiliary; e.g. Sentinel-1 noise/calibration lines)
+    /auxiliary             optional group: named arrays a reader keeps beside the echo, never focused
+                           (RawProduct.auxiliary; e.g. Sentinel-1 noise/calibration packets under s1/,
+                           NISAR calibration lines (calType != 0) under calibration/: echo (n_cal,
+                           n_channels, n_samples), line (their zeroed slots in /echo), cal_type,
+                           azimuth_time)
     /truth                 optional group, simulated products only: scene_toml (attr), targets
                            (compound table), and any truth arrays (e.g. doppler_centroid_hz)
 

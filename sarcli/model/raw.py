@@ -57,7 +57,12 @@ class Attitude:
 
 @dataclass
 class RawProduct:
-    """In-memory stripmap raw product. ``echo`` is (n_lines, n_samples) complex64, channel 0."""
+    """In-memory stripmap raw product. ``echo`` is (n_lines, n_samples) complex64, channel 0.
+
+    ``calibration``: lines that are not echoes (internal calibration pulses), kept for inspection and
+    never focused: ``echo`` (n_cal, n_channels, n_samples) complex64, ``line`` (their slots in the line
+    grid, zero in ``echo``), ``azimuth_time``, and reader-specific labels (e.g. ``cal_type``).
+    """
 
     echo: np.ndarray
     azimuth_time: np.ndarray

@@ -49,6 +49,22 @@ class SLC:
     truth: dict[str, Any] | None = None
 
     @classmethod
+    def from_raw(cls, raw, *, image: np.ndarray, azimuth_time: np.ndarray, slant_range: np.ndarray,
+                 doppler: DopplerUsed, algorithm: str, azimuth_spacing_m: float, first_full_line: int,
+                 last_full_line: int, parameters: dict[str, Any] | None = None,
+                 timings: dict[str, float] | None = None) -> SLC:
+        """The SLC of a focuser: what it computed, plus everything the raw product passes through
+        unchanged (epoch, radar, look side, source, orbit, attitude, and the truth of a simulated
+        product, which ``sarcli quality`` compares with; processing never reads it). The one
+        constructor every focuser uses (:mod:`sarcli.focus.base`)."""
+        return cls(image=image, azimuth_time=np.asarray(azimuth_time, np.float64),
+                   slant_range=np.asarray(slant_range, np.float64), epoch_utc=raw.epoch_utc, radar=raw.radar,
+                   doppler=doppler, look_side=raw.look_side, source=raw.source, algorithm=algorithm,
+                   azimuth_spacing_m=float(azimuth_spacing_m), first_full_line=int(first_full_line),
+                   last_full_line=int(last_full_line), parameters=dict(parameters or {}),
+                   timings=dict(timings or {}), orbit=raw.orbit, attitude=raw.attitude, truth=raw.truth)
+
+    @classmethod
     def placeholder(cls, raw, shape: tuple[int, int]) -> SLC:
         """An empty SLC for :func:`slc_writer` to fill while streaming (see :meth:`update_from`)."""
         e = np.zeros(0)

@@ -107,7 +107,8 @@ def _pngs(folder: Path, pair: Any, res: Any, after: Any, conv: Any) -> list[Path
 
 def run(config: Config, provenance: base.Provenance | None = None, progress: base.Progress | None = None) -> Report:
     """Detect, estimate, compensate, write (module docstring)."""
-    from sarcli.ati.compensation import compensate_movers, truth_movers
+    from sarcli.ati.compensation import compensate_movers
+    from sarcli.ati.evaluation import truth_movers
 
     with base.using(provenance):
         base.refuse_overwriting_inputs([config.raw], [config.output, config.png_dir])

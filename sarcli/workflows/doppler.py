@@ -21,7 +21,7 @@ import math
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from sarcli.config import to_mapping
 from sarcli.doppler.options import DopplerOptions
@@ -39,20 +39,26 @@ HEIGHT_RANGE_M = (-1000.0, 9000.0)
 @dataclass(frozen=True)
 class Config:
     """``raw``: raw product (HDF5); ``output``: doppler.h5 to write (None: none); ``plot``: PNG of fdc and
-    fr against range and azimuth (None: none); ``options``: the estimation knobs; ``height``: terrain
-    height under the scene, m above the WGS-84 ellipsoid (processing never reads the simulator's truth)."""
+    fr against range and azimuth (None: none); ``options``: the estimation knobs; the terrain under the
+    scene (:func:`sarcli.io.dem.load_terrain`; processing never reads the simulator's truth):
+    ``height_m`` (m above the WGS-84 ellipsoid) or a DEM raster ``dem`` whose heights are above the
+    ellipsoid or, with ``dem_geoid``, above that geoid."""
 
     raw: Path
     output: Path | None = None
     plot: Path | None = None
     options: DopplerOptions = field(default_factory=DopplerOptions)
-    height: float = 0.0
+    height_m: float = 0.0
+    dem: Path | None = None
+    dem_geoid: Literal["egm96", "egm2008"] | None = None
 
     def __post_init__(self) -> None:
         lo, hi = HEIGHT_RANGE_M
-        if not (math.isfinite(self.height) and lo <= self.height <= hi):
-            raise ConfigError(f"terrain height {self.height} m is not a height above the WGS-84 ellipsoid in "
+        if not (math.isfinite(self.height_m) and lo <= self.height_m <= hi):
+            raise ConfigError(f"terrain height {self.height_m} m is not a height above the WGS-84 ellipsoid in "
                               f"[{lo:.0f}, {hi:.0f}] m")
+        if self.dem_geoid is not None and self.dem is None:
+            raise ConfigError("a DEM geoid (--dem-geoid) needs a DEM (--dem)")
 
 
 @dataclass
@@ -90,22 +96,24 @@ class DopplerReport(Report):
 
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> DopplerReport:
     """Estimate the Doppler of ``config.raw`` (``sarcli.doppler.api.estimate_doppler`` over a constant
-    terrain height), write the product and the plot; ``progress(stage, done, total)``."""
+    terrain height or a DEM), write the product and the plot; ``progress(stage, done, total)``."""
     from sarcli.doppler.api import estimate_doppler
+    from sarcli.io.dem import load_terrain
     from sarcli.io.raw import read_raw
-    from sarcli.model.terrain import ConstantHeight
 
-    refuse_overwriting_inputs([config.raw], [config.output, config.plot])
+    refuse_overwriting_inputs([config.raw, config.dem], [config.output, config.plot])
     with using(provenance):
         raw = read_raw(config.raw)
+        terrain = load_terrain(config.height_m, config.dem, config.dem_geoid)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            model = estimate_doppler(raw, config.options, terrain=ConstantHeight(config.height), progress=progress)
+            model = estimate_doppler(raw, config.options, terrain=terrain, progress=progress)
         assert model.summary is not None  # estimate_doppler always returns one
         if config.output is not None:
             from sarcli.io.doppler_product import write_doppler
 
-            write_doppler(config.output, model, inputs=(config.raw,), parameters=to_mapping(config))
+            write_doppler(config.output, model, inputs=tuple(p for p in (config.raw, config.dem) if p is not None),
+                          parameters=to_mapping(config))
         if config.plot is not None:
             from sarcli.doppler.plot import plot_doppler
 

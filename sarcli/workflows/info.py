@@ -59,6 +59,10 @@ class Report(base.Report):
         s = self.summary
         if s.get("product_type") == "geotiff":
             return _geotiff_lines(s)
+        if s.get("product_type") == "nisar_rslc" and "frequencies" in s:
+            layers = "; ".join(f"{k}: {', '.join(v)}" for k, v in s["frequencies"].items())
+            return [f"{s['file']}: NISAR RSLC ({s['band']}-band, mission {s['mission_id']}), image {s['shape'][0]} x "
+                    f"{s['shape'][1]}; layers {layers}"]
         if "products" in s:
             out = [f"{s['file']}: raw input ({s['format']}), {len(s['products'])} data sets"]
             for p in s["products"]:
@@ -88,6 +92,9 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
             if head.startswith(HDF5_SIGNATURE) and _is_product(one):
                 _log.info("%s: a sarcli product", one)
                 return Report(summarize(one))
+            if head.startswith(HDF5_SIGNATURE) and _is_rslc(one):
+                _log.info("%s: a NISAR RSLC (not written by sarcli)", one)
+                return Report(describe_rslc(one))
         _log.info("%s: not a product or a GeoTIFF; asking the sensor readers", " ".join(map(str, sources)))
         return Report(describe_raw_input(sources, config.format, config.options))
 
@@ -104,6 +111,22 @@ def _is_product(path: Path) -> bool:
             return "product_type" in f.attrs
     except OSError:
         return False
+
+
+def _is_rslc(path: Path) -> bool:
+    from sarcli.io.nisar.rslc import sniff_rslc
+
+    return sniff_rslc(path)
+
+
+def describe_rslc(path: Path) -> dict[str, Any]:
+    """A NISAR RSLC as ISCE3 (or another NISAR tool) writes it: band, layers, image shape, mission."""
+    from sarcli.io.nisar.rslc import rslc_contents
+
+    c = rslc_contents(path)
+    return {"file": str(path), "product_type": "nisar_rslc", "band": c.band,
+            "frequencies": {f"frequency{k}": v for k, v in c.frequencies.items()}, "shape": list(c.shape),
+            "mission_id": c.mission_id, "written_by_sarcli": c.written_by_sarcli}
 
 
 def _attrs(obj) -> dict[str, Any]:
@@ -125,8 +148,11 @@ def _datasets(f) -> list[dict[str, Any]]:
 
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset):
+            units = obj.attrs.get("units", None)
+            if isinstance(units, bytes):
+                units = units.decode(errors="replace")
             found.append({"path": "/" + name, "shape": list(obj.shape), "dtype": str(obj.dtype),
-                          "units": obj.attrs.get("units", None)})
+                          "units": None if units is None else str(units)})
     f.visititems(visit)
     return found
 

@@ -43,7 +43,7 @@ def test_cli_json_product_and_plot(cli, raw_file, tmp_path, clutter_raw):
     np.testing.assert_allclose(m.fdc(rho, t), ref.fdc(rho, t), rtol=0, atol=1e-9)
     np.testing.assert_allclose(m.fr(rho, t), ref.fr(rho, t), rtol=1e-14)
     assert m.summary.ambiguity == d["ambiguity"] and m.parameters["options"]["az_block"] == 512
-    assert m.ambiguity_resolved and m.parameters["height"] == 0.0
+    assert m.ambiguity_resolved and m.parameters["height_m"] == 0.0
     assert to_jsonable(m.summary.to_dict()) == {k: v for k, v in d.items() if k not in ("output", "warnings", "blocks")}
     np.testing.assert_array_equal(m.blocks["ambiguity"], [b["ambiguity"] for b in d["blocks"]])
     assert m.blocks["valid"].dtype == bool

@@ -238,7 +238,40 @@ def test_reference_height_is_an_input_not_read_from_the_truth(high_raw, cli, tmp
         r = cli("doppler", path, "--height", height, "--az-block", "512", "--rg-block", "96", "-o", out)
         assert r.exit_code == 0, r.stderr
         m = read_doppler(out)
-        assert m.parameters["height"] == height
+        assert m.parameters["height_m"] == height
         b = m.blocks
         errs[height] = np.max(np.abs(b["fdc_orbit_hz"] - np.interp(b["range_m"], rho, tf)))
     assert errs[1500.0] < 0.01 < 1.0 < errs[0.0]
+
+
+def test_dem_terrain_equals_the_constant_height_it_holds(high_raw, cli, tmp_path):
+    """``--dem`` reaches the geometry: a flat DEM 1500 m above the ellipsoid (EPSG:4326, covering the scene)
+    gives the same orbit-model centroid as ``--height 1500``, to the DEM's bilinear exactness (a plane)."""
+    import rasterio
+    from rasterio.transform import from_origin
+
+    from orbit.geodetic import ecef_to_geodetic
+    from sarcli.focus.geolocation import zero_doppler_points
+    from sarcli.io.doppler_product import read_doppler
+    from sarcli.io.raw import write_raw
+
+    r = high_raw.radar
+    rho = high_raw.slant_range()
+    p = zero_doppler_points(high_raw.orbit, high_raw.epoch_utc, np.array([0.0]), np.array([rho[rho.size // 2]]),
+                            r.wavelength_m, high_raw.look_side, ConstantHeight(1500.0))
+    lat, lon, _ = ecef_to_geodetic(np.asarray(p).reshape(-1, 3))
+    step = 0.01  # deg; the scene spans ~0.1 deg: a 2 x 2 deg DEM covers it with any squint
+    z = np.full((200, 200), 1500.0)
+    with rasterio.open(tmp_path / "flat.tif", "w", driver="GTiff", height=200, width=200, count=1, dtype="float64",
+                       crs="EPSG:4326", transform=from_origin(float(lon[0]) - 1.0, float(lat[0]) + 1.0, step,
+                                                              step)) as ds:
+        ds.write(z, 1)
+    path = tmp_path / "high.h5"
+    write_raw(path, high_raw)
+    out = {}
+    for name, args in (("dem", ("--dem", tmp_path / "flat.tif")), ("height", ("--height", 1500.0))):
+        o = tmp_path / f"{name}.h5"
+        res = cli("doppler", path, *args, "--az-block", "512", "--rg-block", "96", "-o", o)
+        assert res.exit_code == 0, res.stderr
+        out[name] = read_doppler(o).blocks["fdc_orbit_hz"]
+    np.testing.assert_allclose(out["dem"], out["height"], atol=1e-4)

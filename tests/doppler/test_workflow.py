@@ -31,7 +31,7 @@ def test_run_from_a_toml_table(raw_file, tmp_path):
 raw = "{raw_file}"
 output = "{tmp_path / 'doppler.h5'}"
 plot = "{tmp_path / 'doppler.png'}"
-height = 120.0
+height_m = 120.0
 [doppler.options]
 az_block = 256
 rg_block = 96
@@ -68,7 +68,7 @@ def test_guards_act_before_any_work(raw_file, tmp_path):
     assert raw_file.read_bytes() == before
     for h in (1e6, -5000.0, float("nan")):
         with pytest.raises(ConfigError, match="terrain height"):
-            wf.Config(raw=raw_file, height=h)
+            wf.Config(raw=raw_file, height_m=h)
     with pytest.raises(ConfigError, match=r"unknown option\(s\) az_blocks; known: ambiguity"):
         from_mapping(wf.Config, {"raw": "r.h5", "options": {"az_blocks": 3}})
     with pytest.raises(ConfigError, match="'sideways' is not one of"):

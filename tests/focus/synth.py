@@ -7,7 +7,8 @@ zero-Doppler time eta0, R(eta) = sqrt(R0^2 + V^2 (eta - eta0)^2). Echo sample (l
 
 with tau_m = 2 (r_first + m dr) / c and the exposure a rect in instantaneous Doppler
 f(eta) = -(2/lam) V^2 (eta - eta0) / R around the centroid fdc = -2 V sin(theta) / lam (the beam),
-``exposure_bw_hz`` wide, so that the processed band (narrower) sees a flat spectrum.
+``exposure_bw_hz`` wide, so that the processed band (narrower) sees a flat spectrum. ``fdc`` may be a
+function of time (a steered beam: the exposure follows fdc(eta_n) line by line).
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ def scene(targets, *, n_lines=1024, n_samples=768, prf=1500.0, fs=24e6, chirp_ra
     for r0, eta0, amp in targets:
         rr = np.sqrt(r0**2 + velocity**2 * (eta - eta0) ** 2)
         f = -(2 / wavelength) * velocity**2 * (eta - eta0) / rr
-        lines = np.nonzero(np.abs(f - fdc) <= 0.5 * exposure_bw_hz)[0]
+        centre = fdc(eta) if callable(fdc) else fdc
+        lines = np.nonzero(np.abs(f - centre) <= 0.5 * exposure_bw_hz)[0]
         for n in lines:
             d = 2 * (rng - rr[n]) / C
             inside = np.abs(d) <= 0.5 * pulse

@@ -178,9 +178,9 @@ def test_cli_compare_quick_json(cli, tmp_path):
 
 
 def test_focus_plugin_registered():
-    from sarcli.focus import algorithms
+    from sarcli.focus import FOCUSERS
 
-    assert "optical" in algorithms.names()
+    assert "optical" in FOCUSERS.names()
 
 
 def test_cli_focus_algorithm_optical(cli, tmp_path):

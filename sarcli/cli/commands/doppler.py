@@ -28,6 +28,9 @@ def doppler(
     plot: Path = typer.Option(None, "--plot", help="PNG of fdc and fr against range and azimuth."),
     height: float = typer.Option(0.0, "--height", help="Terrain height under the scene, metres above the WGS-84 "
                                  "ellipsoid (for the geometric model; stored in the product)."),
+    dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),
+    dem_geoid: str = typer.Option(None, "--dem-geoid", help="The DEM's heights are above this geoid: egm96 | "
+                                  "egm2008 (default: above the ellipsoid)."),
     estimator: str = typer.Option("cde", "--estimator",
                                   help="cde | sde | rc-cde (CDE after range compression) | lb (look balance on "
                                        "the focused scene: robust to scene contrast, needs > 2 look apertures) | "
@@ -73,7 +76,8 @@ def doppler(
                "rg_block": rg_block, "ambiguity": ambiguity, "ambiguity_value": ambiguity_value,
                "fr_method": fr_method, "fdc_model": fdc_model, "fit_degree": _degrees(fit_degree, "--fit-degree"),
                "n_nodes": n_nodes, "exact_attitude": not small_angle}
-    config = from_mapping(Config, {"raw": raw_path, "output": output, "plot": plot, "height": height,
+    config = from_mapping(Config, {"raw": raw_path, "output": output, "plot": plot, "height_m": height, "dem": dem,
+                                   "dem_geoid": dem_geoid,
                                    "options": options}, "sarcli doppler")
     require_output_folders(output, plot)
     with progress_bar(5, label="doppler") as bar:

@@ -78,6 +78,7 @@ READERS: Registry[SensorReader] = Registry("sensor reader", "sarcli.readers", {
     "ceos-rs1": "sarcli.io.readers.ceos_rs1:READER",
     "matlab-cw": "sarcli.io.readers.matlab_cw:READER",
     "sentinel1-l0": "sarcli.io.readers.sentinel1:READER",
+    "nisar-l0b": "sarcli.io.readers.nisar_l0b:READER",
 }, check=_check)
 
 

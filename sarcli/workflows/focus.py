@@ -1,0 +1,335 @@
+"""Focus workflow: raw product -> SLC product (HDF5), amplitude GeoTIFFs and a quicklook (file to file).
+
+What is generic to every focuser (:mod:`sarcli.focus.base`) lives here: the input/output guard, the
+terrain (``--height`` / ``--dem``), the Doppler model (a Doppler product, published ``fdc``/``fr``,
+or estimated from the data when the focuser needs one), streaming the echo from HDF5 block by block
+(or handing the echo in memory to a focuser that does not stream), writing the SLC atomically,
+image statistics, GeoTIFFs and the quicklook, and the report.
+
+Refused before any work, in one line: an output that is an input (same file, symbolic or hard
+link), options out of range, a raw product marked not focusable (``focusable = False`` with its
+``not_focusable_reason``, e.g. TOPS bursts), a Doppler model whose ambiguity is unresolved
+(``ambiguity_resolved`` False) unless ``accept_unresolved_ambiguity`` or published ``fdc``/``fr``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import logging
+import math
+import resource
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from sarcli.config import to_mapping
+from sarcli.errors import ConfigError, ProductError
+from sarcli.workflows.base import Progress, Provenance, Report, no_progress, refuse_overwriting_inputs, using
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Config:
+    """``sarcli focus`` as data (TOML table ``[focus]``).
+
+    raw, output: the raw product and the SLC to write; doppler: a Doppler product, or fdc (Hz) and
+    fr (Hz/s) at mid-swath, or neither (estimated from the data); algorithm: a focuser name
+    (:data:`sarcli.focus.FOCUSERS`); options: the focuser's options (its ``Options`` fields);
+    height_m / dem / dem_geoid: the terrain (:func:`sarcli.io.dem.load_terrain`); geotiff (map
+    projected, ``crs`` default UTM, ``pixel_spacing_m``), geotiff_slant, quicklook: optional products
+    with looks_az x looks_rg looks; channel: receive channel (0 = /echo);
+    accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved.
+    """
+
+    raw: Path
+    output: Path
+    doppler: Path | None = None
+    fdc: float | None = None
+    fr: float | None = None
+    algorithm: str = "rd"
+    options: dict[str, Any] = field(default_factory=dict)
+    height_m: float = 0.0
+    dem: Path | None = None
+    dem_geoid: Literal["egm96", "egm2008"] | None = None
+    geotiff: Path | None = None
+    geotiff_slant: Path | None = None
+    quicklook: Path | None = None
+    crs: str | None = None
+    pixel_spacing_m: float | None = None
+    looks_az: int = 1
+    looks_rg: int = 1
+    channel: int = 0
+    accept_unresolved_ambiguity: bool = False
+
+    def __post_init__(self) -> None:
+        if self.looks_az < 1 or self.looks_rg < 1:
+            raise ConfigError(f"--looks-az and --looks-rg must be at least 1, got {self.looks_az} and {self.looks_rg}")
+        if self.pixel_spacing_m is not None and not (math.isfinite(self.pixel_spacing_m) and self.pixel_spacing_m > 0):
+            raise ConfigError(f"--pixel-spacing must be a positive number of metres, got {self.pixel_spacing_m}")
+        if self.doppler is not None and (self.fdc is not None or self.fr is not None):
+            raise ConfigError("give either --doppler or --fdc/--fr, not both")
+        if (self.fdc is None) != (self.fr is None):
+            raise ConfigError("--fdc and --fr go together (centroid Hz and Doppler rate Hz/s)")
+        for name in ("fdc", "fr", "height_m"):
+            v = getattr(self, name)
+            if v is not None and not math.isfinite(v):
+                raise ConfigError(f"--{name.replace('_m', '')} must be a finite number, got {v}")
+        if self.channel < 0:
+            raise ConfigError(f"--channel must be >= 0, got {self.channel}")
+        if self.crs is not None:
+            from pyproj import CRS
+            from pyproj.exceptions import CRSError
+
+            try:
+                CRS.from_user_input(self.crs)
+            except CRSError:
+                raise ConfigError(f"--crs {self.crs!r} is not a known coordinate reference system "
+                                  "(e.g. EPSG:32610)") from None
+
+    @property
+    def outputs(self) -> tuple[Path | None, ...]:
+        return (self.output, self.geotiff, self.geotiff_slant, self.quicklook)
+
+
+@dataclass
+class FocusReport(Report):
+    """What ``sarcli focus --json`` prints."""
+
+    input: str
+    products: dict[str, str]
+    algorithm: str
+    doppler_source: str
+    shape: list[int]
+    doppler_used: dict[str, float]
+    image_statistics: dict[str, Any]
+    timings_s: dict[str, float]
+    peak_rss_bytes: int
+    warnings: list[str]
+    parameters: dict[str, Any]
+
+    def lines(self) -> list[str]:
+        du = self.doppler_used
+        out = [f"focused {Path(self.input).name} -> {self.products['slc']} ({self.shape[0]} x {self.shape[1]}, "
+               f"{self.algorithm}) in {self.timings_s['total_s']:.2f} s; Doppler {self.doppler_source}: fdc "
+               f"{du['fdc_hz_mid']:.1f} Hz, fr {du['fr_hz_per_s_mid']:.2f} Hz/s at mid-swath; peak RSS "
+               f"{self.peak_rss_bytes / 2**20:.0f} MiB"]
+        out += [f"wrote {v}" for k, v in self.products.items() if k not in ("slc", "crs")]
+        return out
+
+
+def _check_outputs(config: Config) -> None:
+    for p in config.outputs:
+        if p is not None and not Path(p).resolve().parent.is_dir():
+            raise ConfigError(f"output folder {Path(p).resolve().parent} does not exist: create it first")
+
+
+def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_echo):
+    """(model, how): from the Doppler product, from (fdc, fr), or estimated from the data."""
+    if config.doppler is not None:
+        from sarcli.io.doppler_product import read_doppler
+
+        return read_doppler(config.doppler), f"read from {Path(config.doppler).name}"
+    if config.fdc is not None:
+        from sarcli.model.constants import C_LIGHT
+        from sarcli.model.doppler import GeometricDoppler
+
+        r_mid = raw.radar.first_range_m + (shape[1] // 2) * C_LIGHT / (2 * raw.radar.range_sampling_rate_hz)
+        return (GeometricDoppler.from_centroid_and_rate(config.fdc, config.fr, r_mid, raw.radar.wavelength_m),
+                f"given: fdc {config.fdc:.1f} Hz, fr {config.fr:.2f} Hz/s at {r_mid:.0f} m")
+    from sarcli.doppler.api import estimate_doppler
+
+    log.info("no Doppler product given: estimating the centroid and rate from the data")
+    full = load_echo()
+    if "terrain" in inspect.signature(estimate_doppler).parameters:
+        return estimate_doppler(full, terrain=terrain), "estimated from the data"
+    return estimate_doppler(full), "estimated from the data"
+
+
+def _refuse_unresolved(model, config: Config) -> None:
+    if getattr(model, "ambiguity_resolved", True) is False and not config.accept_unresolved_ambiguity:
+        raise ProductError("the Doppler centroid's PRF ambiguity is unresolved (the model may be whole PRFs off): "
+                           "give the centroid with --fdc/--fr, resolve it in 'sarcli doppler' (an orbit, "
+                           "--ambiguity), or accept it with --accept-unresolved-ambiguity")
+
+
+def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> FocusReport:
+    """Focus ``config.raw`` into ``config.output`` (and the optional images); see the module docstring."""
+    from sarcli.focus import FOCUSERS
+    from sarcli.focus.base import make_plan, options_for, run_blocks
+
+    progress = progress or no_progress
+    with using(provenance):
+        t_start = time.perf_counter()
+        refuse_overwriting_inputs((config.raw, config.doppler, config.dem), config.outputs)
+        _check_outputs(config)
+        focuser = FOCUSERS.get(config.algorithm)
+        options = options_for(focuser, config.options)
+        from sarcli.io.dem import load_terrain
+        from sarcli.io.raw import raw_shape, read_raw
+
+        raw = read_raw(config.raw, load_echo=False)
+        _refuse_unfocusable(raw, config.raw)
+        if not 0 <= config.channel < raw.n_channels:
+            raise ConfigError(f"{config.raw}: product has {raw.n_channels} channel(s), channel {config.channel} "
+                              "requested")
+        if (config.geotiff or config.geotiff_slant) and (raw.orbit is None or raw.orbit.frame == "LOCAL"):
+            raise ConfigError(f"{config.raw}: GeoTIFF needs an Earth orbit (ECI/ECEF state vectors); this product "
+                              f"has {'none' if raw.orbit is None else 'a LOCAL (flat) frame'}: drop "
+                              "--geotiff/--geotiff-slant")
+        terrain = load_terrain(config.height_m, config.dem, config.dem_geoid)
+        shape = raw_shape(config.raw)
+        load_echo = _Echo(config.raw)
+
+        t0 = time.perf_counter()
+        model, how = (None, "not used") if not focuser.needs_doppler else _doppler_model(config, raw, shape, terrain,
+                                                                                        load_echo)
+        if model is not None and config.fdc is None:
+            _refuse_unresolved(model, config)
+        t_doppler = time.perf_counter() - t0
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            t0 = time.perf_counter()
+            slc = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo, make_plan,
+                                 run_blocks, progress)
+            t_focus = time.perf_counter() - t0
+        msgs = [str(w.message) for w in caught]
+        for m in msgs:
+            log.warning(m)
+        t0 = time.perf_counter()
+        stats = _statistics(config.output)
+        products = _products(config, terrain, how)
+        t_products = time.perf_counter() - t0
+        d = slc.doppler
+        import numpy as np
+
+        mid = d.fdc_hz.shape[1] // 2
+        timings = {"doppler_s": t_doppler, "focus_s": t_focus,
+                   **{(k if k.endswith("_s") else f"{k}_s"): float(v) for k, v in slc.timings.items()},
+                   "statistics_and_products_s": t_products}
+        timings["total_s"] = time.perf_counter() - t_start
+        return FocusReport(
+            input=str(config.raw), products=products, algorithm=config.algorithm, doppler_source=how,
+            shape=[int(shape[0]), int(shape[1])],
+            doppler_used={"fdc_hz_min": float(np.min(d.fdc_hz)), "fdc_hz_max": float(np.max(d.fdc_hz)),
+                          "fdc_hz_mid": float(np.median(d.fdc_hz[:, mid])),
+                          "fr_hz_per_s_min": float(np.min(d.fr_hz_per_s)),
+                          "fr_hz_per_s_max": float(np.max(d.fr_hz_per_s)),
+                          "fr_hz_per_s_mid": float(np.median(d.fr_hz_per_s[:, mid])),
+                          "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, mid]))},
+            image_statistics=stats, timings_s=timings,
+            peak_rss_bytes=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, warnings=msgs,
+            parameters=slc.parameters)
+
+
+def _refuse_unfocusable(raw, path: Path) -> None:
+    extra = raw.extra_attrs or {}
+    flag = extra.get("focusable", True)
+    if flag is False or (hasattr(flag, "dtype") and not bool(flag)):
+        reason = extra.get("not_focusable_reason") or "the reader marked it not focusable"
+        raise ProductError(f"{path}: this raw product cannot be focused as stripmap: {reason}")
+
+
+def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain, load_echo, make_plan, run_blocks,
+                   progress: Progress):
+    """Plan, stream the blocks into the SLC product, write its metadata; returns the SLC metadata."""
+    from sarcli.io.h5common import open_product
+    from sarcli.io.slc import slc_writer
+    from sarcli.model.slc import SLC
+
+    ch = config.channel
+    if focuser.streams:
+        plan_raw = raw
+    else:
+        full = load_echo()
+        plan_raw = dataclasses.replace(full, echo=full.channel(ch), echo_channels=None)
+        shape = plan_raw.echo.shape
+    plan = make_plan(focuser, plan_raw, shape, model, options, terrain)
+    meta = SLC.placeholder(raw, plan.output_shape)
+    inputs = tuple(p for p in (config.raw, config.doppler, config.dem) if p is not None)
+    with slc_writer(config.output, meta, plan.output_shape, inputs=inputs) as out:
+        def sink(first, block):
+            out[first:first + block.shape[0]] = block
+
+        def on_block(done, total):
+            progress("focusing", done, total)
+
+        if focuser.streams and load_echo.raw is None:
+            with open_product(config.raw, "raw") as f:
+                ds = f["echo"] if ch == 0 else f["echo_channels"]
+
+                def read(a, b):
+                    return ds[a:b] if ch == 0 else ds[ch - 1, a:b]
+
+                slc = run_blocks(focuser, plan, read, sink, on_block)
+        else:
+            echo = load_echo().channel(ch) if focuser.streams else plan_raw.echo
+            slc = run_blocks(focuser, plan, lambda a, b: echo[a:b], sink, on_block)
+        slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": to_mapping(config)}
+        meta.update_from(slc)
+    return slc
+
+
+class _Echo:
+    """The raw product with its echo, read on first call (the estimator and non-streaming focusers need
+    it in memory; once read, streaming focusers use it instead of reading the file again)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.raw = None
+
+    def __call__(self):
+        if self.raw is None:
+            from sarcli.io.raw import read_raw
+
+            self.raw = read_raw(self.path)
+        return self.raw
+
+
+def _products(config: Config, terrain, how: str) -> dict[str, str]:
+    products = {"slc": str(config.output)}
+    if not (config.geotiff or config.geotiff_slant or config.quicklook):
+        return products
+    from sarcli.io.slc import read_slc
+
+    full = read_slc(config.output)
+    tags = {"source_product": Path(config.output).name, "algorithm": config.algorithm, "doppler": how}
+    if config.geotiff_slant:
+        from sarcli.focus.geocode import write_slant_geotiff
+
+        write_slant_geotiff(config.geotiff_slant, full, config.looks_az, config.looks_rg, tags, terrain)
+        products["geotiff_slant"] = str(config.geotiff_slant)
+    if config.geotiff:
+        from sarcli.focus.geocode import write_map_geotiff
+
+        used = write_map_geotiff(config.geotiff, full, config.looks_az, config.looks_rg, config.crs,
+                                 config.pixel_spacing_m, tags, terrain)
+        products["geotiff"] = str(config.geotiff)
+        products["crs"] = used
+    if config.quicklook:
+        from sarcli.focus.quicklook import write_slc_quicklook
+
+        write_slc_quicklook(config.quicklook, full, config.looks_az, config.looks_rg)
+        products["quicklook"] = str(config.quicklook)
+    return products
+
+
+def _statistics(path: Path) -> dict:
+    """Image statistics over the fully focused lines, read in row blocks (bounded memory)."""
+    from sarcli.errors import SarcliError
+    from sarcli.focus.quality import image_statistics
+    from sarcli.io.h5common import open_product
+
+    with open_product(path, "slc") as f:
+        ds = f["image"]
+        a = int(f.attrs.get("first_full_line", 0))
+        b = int(f.attrs.get("last_full_line", ds.shape[0] - 1)) + 1
+        if b <= a:
+            a, b = 0, ds.shape[0]
+        try:
+            return image_statistics(ds[c:min(b, c + 1024)] for c in range(a, b, 1024))
+        except SarcliError:
+            return {}
