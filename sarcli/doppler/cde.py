@@ -40,7 +40,11 @@ class BlockCorrelation:
     """Lag-1 correlation sums on a (n_az_blocks, n_rg_blocks) grid.
 
     ``corr`` complex128 sums C, ``energy`` float64 E, ``pairs`` int64 N; ``line0``/``sample0`` first
-    line/sample of each block and ``n_lines``/``n_samples`` its extent (1-D, per axis).
+    line/sample of each block and ``n_lines``/``n_samples`` its extent (1-D, per axis);
+    ``line_energy`` (n_lines, n_rg_blocks) float64: the energy of each line pair (m, m + lag) of a block,
+    (|h(m)|^2 + |h(m + lag)|^2) / 2 summed over the range block's samples (of the complex samples, also
+    for the SDE), 0 for lines that start no pair inside their block (the scene-contrast error of a
+    block, ``sarcli.doppler.contrast``, reads the azimuth power profile from it).
     """
 
     corr: np.ndarray
@@ -51,6 +55,7 @@ class BlockCorrelation:
     sample0: np.ndarray
     n_samples: np.ndarray
     estimator: str = "cde"
+    line_energy: np.ndarray | None = None
 
     def phase_rho(self) -> np.ndarray:
         """Complex lag-1 correlation coefficient per block (CDE: C/E; SDE: arcsine-corrected)."""
@@ -129,7 +134,7 @@ def _sgn(x):
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im, energy, pairs):
+def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im, energy, pairs, line_en):
     # x is the echo viewed as float32 (n_lines, 2 n_samples): interleaved re, im (SIMD-friendly).
     # Azimuth blocks in parallel; inside a block the lines are streamed in memory order (line m and
     # m+1 whole, line m+1 is still in cache for the next pair) with one accumulator per range block.
@@ -154,6 +159,7 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                 si = np.float32(0.0)
                 se = np.float32(0.0)
                 if sign_mode:
+                    pe = np.float32(0.0)
                     for k in range(n):
                         ar = _sgn(a[2 * k])
                         ai = _sgn(a[2 * k + 1])
@@ -162,6 +168,8 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                         sr += ar * br + ai * bi
                         si += ai * br - ar * bi
                         se += ar * ar + ai * ai + br * br + bi * bi
+                        pe += a[2 * k] * a[2 * k] + a[2 * k + 1] * a[2 * k + 1] + b[2 * k] * b[2 * k] + b[2 * k + 1] * b[2 * k + 1]
+                    line_en[m, jb] = 0.5 * np.float64(pe)
                 else:
                     for k in range(n):
                         ar = a[2 * k]
@@ -171,6 +179,7 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                         sr += ar * br + ai * bi
                         si += ai * br - ar * bi
                         se += ar * ar + ai * ai + br * br + bi * bi
+                    line_en[m, jb] = 0.5 * np.float64(se)
                 cr[jb] += np.float64(sr)
                 ci[jb] += np.float64(si)
                 en[jb] += 0.5 * np.float64(se)
@@ -214,31 +223,35 @@ def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 12
     shp = (l0.size, s0.size)
     cr, ci, en = np.zeros(shp), np.zeros(shp), np.zeros(shp)
     pr = np.zeros(shp, np.int64)
-    _lag_kernel(h.view(np.float32), l0, nl, s0, ns, estimator == "sde", lag, cr, ci, en, pr)
+    le = np.zeros((h.shape[0], s0.size))
+    _lag_kernel(h.view(np.float32), l0, nl, s0, ns, estimator == "sde", lag, cr, ci, en, pr, le)
     if estimator == "sde" or not (np.isfinite(en).all() and np.isfinite(cr).all() and np.isfinite(ci).all()):
         # every sample enters some block energy, so a NaN/inf input shows up there for free (CDE);
         # the sign estimator maps NaN to 0 and needs the explicit pass
         check_finite(h)
-    return BlockCorrelation(cr + 1j * ci, en, pr, l0, nl, s0, ns, estimator)
+    return BlockCorrelation(cr + 1j * ci, en, pr, l0, nl, s0, ns, estimator, le)
 
 
 def block_correlation_numpy(echo: np.ndarray, az_block: int = 2048, rg_block: int = 128,
                             estimator: str = "cde", lag: int = 1) -> BlockCorrelation:
     """Plain-numpy reference of :func:`block_correlation` (same block grid)."""
-    h = np.asarray(echo).astype(np.complex128)
-    if estimator == "sde":
-        h = np.sign(h.real) + 1j * np.sign(h.imag)
+    x = np.asarray(echo).astype(np.complex128)
+    h = np.sign(x.real) + 1j * np.sign(x.imag) if estimator == "sde" else x
     l0, nl, s0, ns = _grid(h.shape, az_block, rg_block, lag)
     corr = np.zeros((l0.size, s0.size), complex)
     en = np.zeros(corr.shape)
     pr = np.zeros(corr.shape, np.int64)
+    le = np.zeros((h.shape[0], s0.size))
     for i, (a, na) in enumerate(zip(l0, nl, strict=True)):
         for j, (b, nb) in enumerate(zip(s0, ns, strict=True)):
             blk = h[a:a + na, b:b + nb]
             corr[i, j] = np.sum(blk[lag:] * np.conj(blk[:-lag]))
             en[i, j] = 0.5 * np.sum(np.abs(blk[lag:]) ** 2 + np.abs(blk[:-lag]) ** 2)
             pr[i, j] = max(na - lag, 0) * nb
-    return BlockCorrelation(corr, en, pr, l0, nl, s0, ns, estimator)
+            if na > lag:
+                p = np.abs(x[a:a + na, b:b + nb]) ** 2
+                le[a:a + na - lag, j] = 0.5 * np.sum(p[lag:] + p[:-lag], axis=1)
+    return BlockCorrelation(corr, en, pr, l0, nl, s0, ns, estimator, le)
 
 
 def combine(bc: BlockCorrelation, axis: int) -> BlockCorrelation:
@@ -251,5 +264,8 @@ def combine(bc: BlockCorrelation, axis: int) -> BlockCorrelation:
     else:
         keep["sample0"] = bc.sample0[:1]
         keep["n_samples"] = np.array([bc.n_samples.sum()])
+    le = bc.line_energy
+    if le is not None and axis == 1:
+        le = le.sum(axis=1, keepdims=True)
     return BlockCorrelation(bc.corr.sum(axis, keepdims=True), bc.energy.sum(axis, keepdims=True),
-                            bc.pairs.sum(axis, keepdims=True), estimator=bc.estimator, **keep)
+                            bc.pairs.sum(axis, keepdims=True), estimator=bc.estimator, line_energy=le, **keep)

@@ -207,12 +207,16 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
         fdc_orbit = geo.fdc(options.fdc_model, False, bb.range_m, bb.time_s)
     data_only: list[DataOnlyEstimate] = []
 
-    def run_data_only() -> tuple[int, float, str]:
+    def run_data_only() -> tuple[int, float]:
         if not data_only and compress:
             sub = central_lines(raw.echo, options.max_lines)
             data_only.extend([mlcc(sub, radar, fbb_scene, options.dataonly_rg_block, raw.replica),
                               mlbf(sub, radar, fbb_scene, options.dataonly_rg_block, raw.replica)])
-        return combine_estimates(data_only)
+            both = combine_estimates(data_only, fbb_scene, prf)
+            if both is not None:
+                data_only.append(both)
+        best = next((e for e in data_only if e.method == "combined"), None)
+        return (0, 0.0) if best is None else (best.ambiguity, best.confidence)
 
     tol = options.half_tolerance
     if options.ambiguity_value is not None:
@@ -227,14 +231,14 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
         conf = amb.rounding_confidence(res.offset_prf, sigma)
         source, resolved = "orbit", res.resolved
         if not res.resolved and compress:
-            n_d, c_d, _ = run_data_only()
+            n_d, c_d = run_data_only()
             n_lo, n_hi = int(np.floor(res.offset_prf)), int(np.ceil(res.offset_prf))
             if n_d in (n_lo, n_hi) and c_d > 0:  # keep the orbit margin: it is what was ambiguous
                 res_d = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, tol)
                 res = dataclasses.replace(res_d, margin=res.margin, offset_prf=res.offset_prf, resolved=False)
                 source, conf, resolved = "orbit+data", c_d, True
     elif mode == "data":
-        n_d, conf, _ = run_data_only()
+        n_d, conf = run_data_only()
         res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, tol)
         source, resolved = "data", res.resolved and conf > 0
     else:

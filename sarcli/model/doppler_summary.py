@@ -59,8 +59,10 @@ def _floats(v: Any) -> np.ndarray:
 
 @dataclass(frozen=True)
 class DataOnlyEstimate:
-    """Absolute centroid of one data-only method (MLCC or MLBF) with its ambiguity and confidence
-    (``sarcli.doppler.dataonly``); ``block_fdc_hz`` per range block."""
+    """Absolute centroid of one data-only method (MLCC, MLBF, or ``combined``: their inverse-variance
+    combination) with its ambiguity and confidence (``sarcli.doppler.dataonly``); ``block_fdc_hz`` per
+    range block (``combined``: the estimates combined); ``dof`` the degrees of freedom of ``sigma_hz``
+    (None: Gaussian, or not recorded by an older product)."""
 
     method: str
     fdc_hz: float
@@ -68,6 +70,7 @@ class DataOnlyEstimate:
     ambiguity: int
     confidence: float
     block_fdc_hz: np.ndarray
+    dof: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
@@ -78,7 +81,8 @@ class DataOnlyEstimate:
         nan = float("nan")
         return cls(str(k["method"]), nan if k["fdc_hz"] is None else float(k["fdc_hz"]),
                    nan if k["sigma_hz"] is None else float(k["sigma_hz"]), int(k["ambiguity"]),
-                   float(k["confidence"]), _floats(k["block_fdc_hz"]))
+                   float(k["confidence"]), _floats(k["block_fdc_hz"]),
+                   None if k.get("dof") is None else float(k["dof"]))
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,8 @@ def test_kernel_matches_numpy_reference(n_lines, n_samples, az, rg, est, lag, se
     np.testing.assert_allclose(a.energy, b.energy, rtol=1e-6, atol=1e-12)
     np.testing.assert_array_equal(a.pairs, b.pairs)
     assert a.n_lines.sum() == n_lines and a.n_samples.sum() == n_samples
+    # the per-pair line energies (of the complex samples, for the SDE too)
+    np.testing.assert_allclose(a.line_energy, b.line_energy, rtol=1e-6, atol=1e-12)
 
 
 @pytest.mark.parametrize("est", ["cde", "sde"])

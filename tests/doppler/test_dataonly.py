@@ -6,6 +6,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sarcli.doppler.cde import block_correlation, combine
 from sarcli.doppler.dataonly import DataOnlyEstimate, combine_estimates, mlbf, mlcc
@@ -28,14 +30,52 @@ def test_mlcc_mlbf_resolve_synthetic_ambiguity(fdc):
         assert est.confidence > 0.7
 
 
-def test_combination_rule_is_conservative():
-    a = DataOnlyEstimate("mlcc", -7000.0, 100.0, -6, 0.9, np.zeros(1))
+def _t_or_normal(dof):
+    from scipy import stats
+
+    return stats.norm if dof is None else stats.t(dof)
+
+
+def test_combination_is_the_inverse_variance_mean_with_birge_scaling():
+    """Expected values computed here from the formulas (maximum likelihood for independent Gaussian
+    errors, Birge ratio, Welch-Satterthwaite), not from the code under test."""
+    prf, fbb = 1256.98, 485.5
+    a = DataOnlyEstimate("mlcc", -7000.0, 100.0, -6, 0.9, np.zeros(1), 6.0)
+    b = DataOnlyEstimate("mlbf", -7100.0, 200.0, -6, 0.6, np.zeros(1), 2.0)
+    c = combine_estimates([a, b], fbb, prf)
+    w = np.array([1e-4, 0.25e-4])
+    assert c.method == "combined"
+    assert c.fdc_hz == pytest.approx((-7000.0 * w[0] - 7100.0 * w[1]) / w.sum())  # -7020
+    assert c.sigma_hz == pytest.approx(w.sum() ** -0.5)  # chi2 = 0.2 < 1: no scaling
+    assert c.dof == pytest.approx(w.sum() ** 2 / (w[0] ** 2 / 6.0 + w[1] ** 2 / 2.0))
+    y, s_y = (c.fdc_hz - fbb) / prf, c.sigma_hz / prf
+    t = _t_or_normal(c.dof)
+    assert c.ambiguity == -6
+    assert c.confidence == pytest.approx(t.cdf((-5.5 - y) / s_y) - t.cdf((-6.5 - y) / s_y))
+    # disagreement beyond the errors: chi2 = 18 on 1 degree of freedom -> sigma x sqrt(18)
     b = DataOnlyEstimate("mlbf", -7600.0, 100.0, -7, 0.6, np.zeros(1))
-    n, conf, _ = combine_estimates([a, b])
-    assert n == -6 and conf == pytest.approx(0.9 * 0.4)
-    b = dataclasses.replace(b, ambiguity=-6)
-    assert combine_estimates([a, b])[1] == pytest.approx(0.9)
-    assert combine_estimates([])[1] == 0.0
+    c = combine_estimates([a, b], fbb, prf)
+    assert c.fdc_hz == pytest.approx(-7300.0) and c.sigma_hz == pytest.approx(100.0 / np.sqrt(2) * np.sqrt(18.0))
+    assert c.dof is None  # one Gaussian input: Gaussian
+    # the Squamish block of the Vancouver pass: MLCC -7 and MLBF -5, both weak; together -6
+    mlcc_ = DataOnlyEstimate("mlcc", -7823.0, 1082.0, -7, 0.39, np.zeros(8), 6.6)
+    mlbf_ = DataOnlyEstimate("mlbf", -6287.0, 791.0, -5, 0.35, np.zeros(8), 1.1)
+    c = combine_estimates([mlcc_, mlbf_], 548.8, prf)
+    assert c.ambiguity == -6 and c.fdc_hz == pytest.approx(-6822.0, abs=1.0)
+    assert combine_estimates([], fbb, prf) is None
+    assert combine_estimates([dataclasses.replace(a, sigma_hz=np.inf)], fbb, prf) is None
+
+
+@settings(max_examples=50, deadline=None)
+@given(f=st.floats(-9000, 9000), s=st.floats(1.0, 2000.0), dof=st.one_of(st.none(), st.floats(1.0, 50.0)),
+       fbb=st.floats(-600, 600))
+def test_one_estimate_combines_to_itself(f, s, dof, fbb):
+    e = DataOnlyEstimate("mlbf", f, s, 0, 0.0, np.zeros(1), dof)
+    c = combine_estimates([e], fbb, 1256.98)
+    assert c.fdc_hz == pytest.approx(f) and c.sigma_hz == pytest.approx(s)
+    assert c.dof is None if dof is None else c.dof == pytest.approx(dof)
+    assert c.ambiguity == int(np.floor((f - fbb) / 1256.98 + 0.5))
+    assert 0.0 <= c.confidence <= 1.0
 
 
 def test_real_vancouver_block_data_only_ambiguity(shared_data):

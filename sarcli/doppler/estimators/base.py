@@ -94,14 +94,36 @@ def block_coordinates(raw: RawProduct, bc: BlockCorrelation, sample_offset: int 
 
 
 def correlation_blocks(raw: RawProduct, bc: BlockCorrelation, options: DopplerOptions,
-                       sample_offset: int = 0) -> BasebandBlocks:
+                       sample_offset: int = 0, data: np.ndarray | None = None) -> BasebandBlocks:
     """Stage 1 output of a lag-1 correlation estimator (CDE, SDE, RC-CDE): per-block centroid, quality,
     SNR-aware validity and weight (``sarcli.doppler.cde``), and the scene centroid from the summed
-    correlation of the valid blocks."""
+    correlation of the valid blocks. ``estimator_info`` holds the standard error of every block
+    (``sigma_hz``: speckle and scene contrast, ``sarcli.doppler.contrast``; its two parts
+    ``sigma_speckle_hz``, ``sigma_scene_hz``), the fitted first-null Doppler offset of the azimuth
+    pattern (``pattern_band_hz``) and the Doppler rate assumed for it. ``data``: the correlated array
+    (default ``raw.echo``), for the pattern fit."""
+    from sarcli.doppler import contrast
+
     prf = raw.radar.prf_hz
     valid = bc.valid(options.noise_sigmas, options.min_quality)
     T, R = block_coordinates(raw, bc, sample_offset)
     total, norm = bc.scene_sum(valid)
-    return BasebandBlocks(bc.baseband(prf), bc.quality(), valid, bc.weight(options.noise_sigmas, options.min_quality),
-                          R, T, float(wrap_frequency(prf * np.angle(total) / (2 * np.pi), prf)),
-                          float(np.abs(total) / max(norm, 1e-300)))
+    scene = float(wrap_frequency(prf * np.angle(total) / (2 * np.pi), prf))
+    weight = bc.weight(options.noise_sigmas, options.min_quality)
+    quality = bc.quality()
+    v = raw.radar.platform_velocity_mps or options.velocity_guess_mps
+    fr = -2.0 * v**2 / (raw.radar.wavelength_m * float(np.median(R)))
+    band = contrast.fit_band(raw.echo if data is None else data, prf, scene, options.max_lines)
+    var_speckle, var_scene = contrast.block_sigmas(bc, contrast.Pattern(band, fr, prf))
+    to_hz = prf / (2 * np.pi)
+    info = {"sigma_hz": _listed(to_hz * np.sqrt(var_speckle + var_scene)),
+            "sigma_speckle_hz": _listed(to_hz * np.sqrt(var_speckle)),
+            "sigma_scene_hz": _listed(to_hz * np.sqrt(var_scene)),
+            "pattern_band_hz": band, "pattern_fr_hz_per_s": fr}
+    return BasebandBlocks(bc.baseband(prf), quality, valid, weight, R, T, scene,
+                          float(np.abs(total) / max(norm, 1e-300)), info)
+
+
+def _listed(a: np.ndarray) -> list:
+    """A 2-D array as nested lists for JSON, non-finite values as None."""
+    return [[float(x) if np.isfinite(x) else None for x in row] for row in np.asarray(a, np.float64)]

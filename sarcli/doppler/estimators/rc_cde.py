@@ -25,7 +25,7 @@ class RangeCompressedCDE:
             raise ConfigError("rc-cde needs a range extent longer than the pulse; use the cde estimator")
         rc, extent = range_compress_extended(raw.echo, raw.radar, raw.replica)
         # block ranges: the compressed array's sample 0 is raw sample extent.start (negative)
-        return correlation_blocks(raw, block_correlation(rc, o.az_block, o.rg_block, "cde"), o, extent.start)
+        return correlation_blocks(raw, block_correlation(rc, o.az_block, o.rg_block, "cde"), o, extent.start, rc)
 
 
 ESTIMATOR = RangeCompressedCDE()
