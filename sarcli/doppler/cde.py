@@ -168,7 +168,8 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                         sr += ar * br + ai * bi
                         si += ai * br - ar * bi
                         se += ar * ar + ai * ai + br * br + bi * bi
-                        pe += a[2 * k] * a[2 * k] + a[2 * k + 1] * a[2 * k + 1] + b[2 * k] * b[2 * k] + b[2 * k + 1] * b[2 * k + 1]
+                        pe += (a[2 * k] * a[2 * k] + a[2 * k + 1] * a[2 * k + 1]
+                               + b[2 * k] * b[2 * k] + b[2 * k + 1] * b[2 * k + 1])
                     line_en[m, jb] = 0.5 * np.float64(pe)
                 else:
                     for k in range(n):

@@ -71,7 +71,8 @@ def read_agc_table(path: str | os.PathLike, variable: str | None = None) -> np.n
     names = [k for k in mat if not k.startswith("__")]
     name = variable or (TABLE_VARIABLE if TABLE_VARIABLE in names else (names[0] if len(names) == 1 else None))
     if name is None or name not in mat:
-        raise FormatError(f"{path}: no AGC variable {variable or TABLE_VARIABLE!r} (variables: {', '.join(names) or 'none'})")
+        raise FormatError(f"{path}: no AGC variable {variable or TABLE_VARIABLE!r} "
+                          f"(variables: {', '.join(names) or 'none'})")
     a = np.asarray(mat[name])
     if a.ndim != 1 or a.size < 2 or not (np.issubdtype(a.dtype, np.integer) or np.issubdtype(a.dtype, np.floating)):
         raise FormatError(f"{path}: AGC variable '{name}' is not a 1-D numeric table (shape {a.shape}, {a.dtype})")

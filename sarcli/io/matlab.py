@@ -116,8 +116,12 @@ def _place_lines(echo: np.ndarray, params: dict, params_path: Path, first_line: 
 
     n = echo.shape[0]
     from_file = _param_int(params, "first_rg_line", params_path)
-    line, source = ((first_line, "user") if isinstance(first_line, int) else
-                    (from_file, "run-parameter file") if from_file is not None and first_line is None else (1, "default"))
+    if isinstance(first_line, int):
+        line, source = first_line, "user"
+    elif from_file is not None and first_line is None:
+        line, source = from_file, "run-parameter file"
+    else:  # no start line in the file, or "auto" (decided below from the table)
+        line, source = 1, "default"
     total = _param_int(params, "tot_Nrg_lines", params_path)
     if agc_path is None:
         if total is not None and line + n - 1 > total:
@@ -138,7 +142,8 @@ def _place_lines(echo: np.ndarray, params: dict, params_path: Path, first_line: 
                               f"needs z >= {agc_table.Z_MATCH:g} and twice the next): give first_line")
         line, source = found + 1, "AGC table"
     if line + n - 1 > table.size:
-        raise FormatError(f"a block of {n} lines starting at line {line} runs past the {table.size} lines of the AGC table")
+        raise FormatError(f"a block of {n} lines starting at line {line} runs past the {table.size} lines of the "
+                          "AGC table")
     verdict = agc_table.check_start(al, line - 1)
     if verdict == "contradicted":
         given = "first_rg_line of " + params_path.name if source == "run-parameter file" else "first_line"

@@ -53,7 +53,8 @@ def test_speckle_variance_equals_a_monte_carlo_of_a_stationary_process():
     for _ in range(reps):
         w = rng.standard_normal((n, cols)) + 1j * rng.standard_normal((n, cols))
         x = np.fft.ifft(np.fft.fft(w, axis=0) * np.sqrt(power)[:, None], axis=0)
-        x = x / np.sqrt(np.mean(np.abs(x) ** 2)) + 0.3 * (rng.standard_normal(x.shape) + 1j * rng.standard_normal(x.shape))
+        noise = rng.standard_normal(x.shape) + 1j * rng.standard_normal(x.shape)
+        x = x / np.sqrt(np.mean(np.abs(x) ** 2)) + 0.3 * noise
         c = np.sum(x[1:] * np.conj(x[:-1]))
         phases.append(np.angle(c))
         qs.append(abs(c) / (0.5 * np.sum(np.abs(x[1:]) ** 2 + np.abs(x[:-1]) ** 2)))

@@ -46,8 +46,8 @@ def _notes(attrs: dict, n_lines: int) -> list[str]:
         check = attrs["agc_start_check"]
         z = attrs["agc_start_z"]
         if check == "confirmed":
-            notes.append(f"AGC table applied to lines {line}-{line + n_lines - 1}: the line power steps where the table "
-                         f"does (z = {z:.1f}, next best start {attrs['agc_next_best_z']:.1f})")
+            notes.append(f"AGC table applied to lines {line}-{line + n_lines - 1}: the line power steps where the "
+                         f"table does (z = {z:.1f}, next best start {attrs['agc_next_best_z']:.1f})")
         else:
             notes.append(f"AGC table applied to lines {line}-{line + n_lines - 1}; the line power cannot confirm the "
                          f"start line (z = {z:.1f}, best {attrs['agc_best_z']:.1f} at line {attrs['agc_best_line']})")
