@@ -68,7 +68,7 @@ class DopplerOptions:
     exact_attitude: bool = True
     fr_method: Literal["auto", "orbit", "seed", "mapdrift"] = "auto"
     velocity_guess_mps: float = 7000.0
-    mapdrift_segments: int = 4
+    mapdrift_segments: int = 8
     dataonly_rg_block: int | None = None
     max_lines: int = 4096
 
