@@ -87,6 +87,17 @@ def resolve(fdc_bb: np.ndarray, fdc_unwrapped: np.ndarray, fdc_pred: np.ndarray 
     return AmbiguityResult(n0, nb, margin, block_margin, x, bool(margin >= half_tolerance))
 
 
+def coverage_factor(dof: float) -> float:
+    """t_{0.975, dof} / z_{0.975}: the factor that turns a standard error estimated with ``dof`` degrees of
+    freedom into the standard deviation of a Gaussian with the same 95 % interval, so that "within 2
+    sigma" keeps its meaning for an error estimated from a few groups (8 groups: 1.21; inf: 1)."""
+    from scipy import stats
+
+    if not dof > 0:
+        return float("inf")
+    return float(stats.t.ppf(0.975, dof) / stats.norm.ppf(0.975))
+
+
 def rounding_confidence(offset: float, sigma: float, dof: float | None = None) -> float:
     """P(round(X) = round(offset)) where the error of the estimate ``offset`` has standard error
     ``sigma``: Gaussian, or Student-t with ``dof`` degrees of freedom when sigma itself was estimated

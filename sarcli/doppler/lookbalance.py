@@ -36,7 +36,11 @@ finite-difference step of the slope at the root. A block without a sign change w
 steps, or with a non-negative slope at its root, is invalid. The
 standard error of a block comes from the scatter of -D/D' over ``n_groups`` contiguous groups of its
 pixels (targets in different groups are independent; raw range columns are not, a pulse spans them
-all).
+all), times the coverage factor t_{0.975, n-1} / 1.96 (1.21 for 8 groups,
+``ambiguity.coverage_factor``): estimated from 8 groups, the plain standard error left 90 % of the
+Vancouver 512- vs 1536-line differences within 2 sigma with an rms of difference / sigma of 1.18, which
+is sqrt(7/5), the rms of Student's t with 7 degrees of freedom; 16 smaller groups (32 lines) were not
+independent (85 %, rms 1.34).
 
 Cost: one FFT per range block and two look IFFTs per evaluation of D (some 10-14 per block from the
 CDE's start: bracket, Brent, slope), i.e. about 25 block-sized FFT passes per block (the CDE is one
@@ -51,6 +55,7 @@ import numpy as np
 import scipy.fft as sfft
 from scipy.optimize import brentq
 
+from sarcli.doppler.ambiguity import coverage_factor
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.errors import SarcliError
 
@@ -175,6 +180,6 @@ def look_balance(echo: np.ndarray, prf: float, line0: np.ndarray, n_lines: np.nd
             p_lo, p_hi = look_powers(spec, prf, root, ka[j], band)
             steps = -_balance(p_lo, p_hi, np.array_split(owned[i], n_groups)) / s_i
             fbb[i, j] = wrap_frequency(root, prf)
-            sig[i, j] = np.std(steps, ddof=1) / np.sqrt(steps.size)
+            sig[i, j] = np.std(steps, ddof=1) / np.sqrt(steps.size) * coverage_factor(steps.size - 1)
             slope[i, j] = s_i
     return LookBalance(fbb, sig, pix, centre, slope, margin)

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarcli.doppler import ambiguity as amb
+from sarcli.doppler.ambiguity import coverage_factor
 from sarcli.doppler.agcsteps import GainSteps
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.doppler.dataonly import combine_estimates, mlbf, mlcc
@@ -353,7 +354,9 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
     segments that converged to within 30 % of their start value, weights w_k = the segment's number of
     range samples (the drift sums independent range bins): c = sum w fr/R / sum w/R^2. Its standard
     error comes from the scatter of the segments about the model, s^2 = sum w (fr - c/R)^2 / (n - 1),
-    sigma_c = s / sqrt(sum w/R^2); sigma_Vr = lam sigma_c / (4 Vr) (from Vr = sqrt(-c lam/2)); not
+    sigma_c = s / sqrt(sum w/R^2); sigma_Vr = lam sigma_c / (4 Vr) (from Vr = sqrt(-c lam/2)), times the
+    coverage factor t_{0.975, n-1} / 1.96 (``ambiguity.coverage_factor``: 1.21 for the default 8
+    segments) so that 2 sigma stays a 95 % interval although s has only n - 1 degrees of freedom; not
     defined for a single segment. The model is c R^-1 at every range (no clipping, no flat hold): a
     free slope (fr R linear in R) fitted to a few noisy segments of a narrow swath had the wrong sign on
     the Vancouver block, and a 1/R law cannot be held flat physically.
@@ -396,7 +399,7 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
     sigma_v = None
     if rr.size > 1:
         s2 = np.sum(ww * (ff - c / rr) ** 2) / (rr.size - 1)
-        sigma_v = float(lam * np.sqrt(s2 / swr) / (4.0 * vr))
+        sigma_v = float(lam * np.sqrt(s2 / swr) / (4.0 * vr)) * coverage_factor(rr.size - 1)
     segs = tuple(MapDriftSegment(r, fr, f0, it, conv, used, c / r) for r, fr, f0, it, conv, used in segments)
     grid = geo.grid if geo is not None else ModelGrid.of(raw)
     GR, GT = grid.range_m, grid.time_s
