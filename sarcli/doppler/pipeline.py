@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarcli.doppler import ambiguity as amb
-from sarcli.doppler.ambiguity import coverage_factor
 from sarcli.doppler.agcsteps import GainSteps
+from sarcli.doppler.ambiguity import coverage_factor
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.doppler.dataonly import combine_estimates, mlbf, mlcc
 from sarcli.doppler.estimators import ESTIMATORS
