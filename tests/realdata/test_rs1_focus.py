@@ -26,7 +26,7 @@ def test_data_driven_doppler_focuses_sharper_than_the_published(rs1_pass, cli, t
     ours = json.loads(r.stdout)
     r = cli("focus", raw, "--fdc", "-6900", "--fr", "-1733", "-o", tmp_path / "pub.h5", "--json")
     assert r.exit_code == 0, r.stderr
-    pub = json.loads(r.stdout)
+    assert json.loads(r.stdout)["doppler_used"]["fdc_hz_mid"] == pytest.approx(-6900, abs=1)
     assert ours["doppler_used"]["fdc_hz_mid"] == pytest.approx(-7040, abs=60)  # ambiguity -6, not -5 or -7
     # contrast std(I)/mean(I) and entropy -sum p ln p (p = I / sum I), plain numpy, over the lines fully
     # focused in both images (the aperture, and so the focused span, follows the rate)
