@@ -738,7 +738,7 @@ def section_e(raws: dict, models: dict, work: Path) -> tuple[str, dict]:
                         f"{results['gentle']['pixel_shift_max_m']:.0f} m (h / tan(incidence) = "
                         f"{MOUNTAIN_M / np.tan(np.radians(theta)):.0f} m)")
         ax[1].set_xlabel("slant range from the near edge (km)")
-        ax[1].set_ylabel("zero-Doppler time (s)")
+        ax[1].set_ylabel("zero-Doppler time after the first fully focused line (s)")
         ax[1].invert_yaxis()
     look = amp[a:b + 1:4].reshape(-1, amp.shape[1])
     n3 = look.shape[1] // 3 * 3
