@@ -14,6 +14,10 @@ interpolation of the (oversampled) profile and the centre wavelength in the carr
 exact because the profile is referenced to f_c. The kernel evaluates ``exp(+j 4 pi (R_i - R0)/lam)``
 in float32 (``R_i - R0`` stays below ~5 m, so the phase error is < 1e-4 rad) and accumulates in
 complex64. Flagged stops are left out.
+
+Grid backprojection (:func:`backproject_grid`): any 3-D track, a reference range per sweep, a
+horizontal Cartesian grid, every sweep integrated (spotlight: no beam footprint), the image the
+complex reflectivity; phase model and derivation in its docstring, float64 throughout.
 """
 
 from __future__ import annotations
@@ -237,6 +241,16 @@ def backproject_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_ran
     w_i the ``azimuth_window`` taper over the sweeps in their stored (track) order times their
     validity. A stop whose rho_i falls outside the profile ([-R_max, R_max)) is left out; ``fraction`` is
     the share of the weights a pixel used (1 inside the unambiguous window of every sweep).
+
+    De-ramped phase histories are this model with r_i the de-ramp reference: dechirping on receive
+    against a copy delayed by 2 r_i/c and removing the residual video phase leaves, at instantaneous
+    frequency f_k, ``s exp(-j 4 pi f_k (R - r_i)/c)`` = the GB-SAR sweep times ``exp(+j 4 pi f_k r_i/c)``.
+    AFRL GOTCHA's ``fp`` with ``r0`` (range to the scene centre, the frame origin) is that: AFRL's own
+    backprojection [GorhamMoore2010] takes ``ifft(fp)`` as peaking at +dR, dR = |a - p| - r0, and
+    multiplies by ``exp(+j 4 pi f_min dR/c)``, the same sign. Checked on the data
+    (``tests/gbsar/test_gotcha.py``): the conjugate, i.e. the other sign, does not defocus at 10 km but
+    mirrors the scene through its centre (dR(-p) = -dR(p) to first order in |p|/R), while reversing the
+    range envelope alone against the carrier (the frequency axis) destroys the focus.
     """
     ant = np.ascontiguousarray(antenna_xyz, np.float64)
     ref = np.zeros(ant.shape[0]) if reference_range is None else np.ascontiguousarray(reference_range, np.float64)

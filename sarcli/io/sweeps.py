@@ -220,10 +220,11 @@ def _load_numpy(path: Path) -> _Variables:
 
 
 def _scope(v: _Variables, names: Names) -> str:
-    """Where the default names are looked up: the top level, or inside the file's only struct when the
-    samples are not found at the top (GOTCHA's ``data.fp``)."""
-    if names.data is not None and "." in names.data.split(",")[0]:
-        return names.data.split(",")[0].rpartition(".")[0] + "."
+    """Where the default names are looked up: beside the named samples, else the top level, or inside
+    the file's only struct when the samples are not found at the top (GOTCHA's ``data.fp``)."""
+    if names.data is not None:
+        head = names.data.split(",")[0].rpartition(".")[0]
+        return head + "." if head else ""
     if any(v.array(n) is not None for n in DEFAULTS["data"]):
         return ""
     structs = v.structs()

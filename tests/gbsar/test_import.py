@@ -357,3 +357,15 @@ def test_cli_import_json_and_one_line_errors(cli, tmp_path, known):
     r = cli("gbsar", "import", p, "--data", "nope", "-o", tmp_path / "x.h5")
     assert r.exit_code == 1 and r.stderr.count("\n") == 1 and "'nope' does not exist" in r.stderr
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_defaults_are_looked_up_beside_the_named_samples(tmp_path, known):
+    s, f, xyz, _ = known
+    p = tmp_path / "two.mat"
+    scipy.io.savemat(p, {"S": s, "freq": f, "x": np.arange(N_P) * 0.1,
+                         "meta": {"freq": f + 1.0, "position": xyz}})
+    sw = read_sweeps([p], Names(data="S"))
+    assert sw.used["frequency"] == "freq" and sw.used["position"] == "x"
+    sw = read_sweeps([p], Names(data="S", frequency="meta.freq", position="meta.position"))
+    np.testing.assert_array_equal(sw.frequency, f + 1.0)
+    np.testing.assert_array_equal(sw.position, xyz)
