@@ -346,7 +346,7 @@ def _orient(path: Path, data: np.ndarray, n_f: int, n_p: int, layout: str) -> tu
             raise FormatError(f"{path}: the samples are {a.shape[0]} x {a.shape[1]}, not {layout.replace('-', ' x ')} "
                               f"= {n_f if layout[0] == 'f' else n_p} x {n_p if layout[0] == 'f' else n_f}")
         taken = layout
-    elif fits["frequency-position"] and fits["position-frequency"]:
+    elif fits["frequency-position"] and fits["position-frequency"] and n_f > 1:
         raise ConfigError(f"{path}: the samples are {n_f} x {n_p} with as many frequencies as positions: the layout "
                           "is ambiguous; give --layout frequency-position or position-frequency")
     elif fits["frequency-position"] or fits["position-frequency"]:

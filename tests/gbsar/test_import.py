@@ -8,6 +8,8 @@ import h5py
 import numpy as np
 import pytest
 import scipy.io
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sarcli.errors import ConfigError, FormatError
 from sarcli.io.scan import read_scan
@@ -64,6 +66,25 @@ def test_matlab_struct_with_3d_track_and_reference_range(tmp_path, known, layout
     steps = np.diff(sw.frequency)
     assert np.all(np.abs(steps - steps[0]) <= 1e-6 * steps[0])
     assert "float32" in sw.notes[0]
+
+
+@settings(max_examples=25, deadline=None)
+@given(n_f=st.integers(1, 9), n_p=st.integers(1, 9), transposed=st.booleans(), track=st.booleans(),
+       seed=st.integers(0, 2**31))
+def test_any_shape_either_layout_round_trips(tmp_path_factory, n_f, n_p, transposed, track, seed):
+    """Whatever the sizes, a non-square matrix is oriented from the lengths and read back exactly."""
+    rng = np.random.default_rng(seed)
+    s = rng.standard_normal((n_p, n_f)) + 1j * rng.standard_normal((n_p, n_f))
+    pos = rng.uniform(-5, 5, (n_p, 3) if track else n_p)
+    p = tmp_path_factory.mktemp("any") / "a.npz"
+    np.savez(p, s21=s.T if transposed else s, frequency=1e9 + 1e6 * np.arange(n_f), position=pos)
+    if n_f == n_p and n_p > 1:
+        with pytest.raises(ConfigError, match="ambiguous"):
+            read_sweeps([p])
+        return
+    sw = read_sweeps([p])
+    np.testing.assert_array_equal(sw.samples, s)
+    np.testing.assert_array_equal(sw.position, pos)
 
 
 def test_square_matrix_needs_the_layout(tmp_path, known):
