@@ -1,4 +1,4 @@
-"""The GB-SAR scan product (``product_type = "gbsar_scan"``), schema version 1.
+"""The GB-SAR scan product (``product_type = "gbsar_scan"``), schema versions 1 and 2.
 
 One schema for simulated scans (``sarcli gbsar simulate``) and measured ones (``sarcli gbsar scan``).
 Measured scans are written stop by stop: the stop axis is resizable and every completed stop is
@@ -24,9 +24,18 @@ Layout (SI units)::
     /instrument        attributes: settings as applied (if_bandwidth_hz, power_dbm, points, vna_idn,
                        rail_idn, settle_s, ...), free-form but JSON-serializable scalars
     /truth             optional, simulated scans: scene_toml attribute and target tables
+    /antenna_position  optional (schema 2), float64 (n_stops, 3) m: antenna phase centre (x, y, z) of
+                       every sweep in a local Cartesian frame (a 3-D track, e.g. an airborne phase
+                       history); rail_position is then the distance along the track, rail_height its z
+    /reference_range   optional (schema 2), float64 (n_stops,) m: the range r_ref each sweep's phase is
+                       referenced to (de-ramped / motion-compensated phase histories, e.g. to a scene
+                       centre)
 
 Phase convention: a scatterer at one-way range R from the antenna phase centre gives
-S21 ∝ exp(-j*4*pi*f*R/c).
+S21 ∝ exp(-j*4*pi*f*R/c), or S21 ∝ exp(-j*4*pi*f*(R - r_ref)/c) with a reference range.
+A scan without the two optional datasets is written as schema 1, exactly as before they existed
+(an older reader still reads it); one with either is schema 2, which an older reader refuses
+instead of focusing it as a straight rail.
 """
 
 from __future__ import annotations
@@ -52,6 +61,7 @@ from sarcli.model.gbsar import Antenna, Scan, Site
 
 PRODUCT_TYPE = "gbsar_scan"
 SCHEMA_VERSION = "1"
+SCHEMA_VERSION_TRACK = "2"  # with antenna_position and/or reference_range
 POLARIZATIONS = ("VV", "VH", "HV", "HH")
 
 
@@ -68,6 +78,11 @@ def _validate(s: Scan, where: str) -> None:
     for name in ("rail_position", "rail_height"):
         if getattr(s, name).shape != (n_stops,):
             raise ProductError(f"{where}: {name} must have {n_stops} values")
+    if s.antenna_position is not None and np.shape(s.antenna_position) != (n_stops, 3):
+        raise ProductError(f"{where}: antenna_position has shape {np.shape(s.antenna_position)}, "
+                           f"expected ({n_stops}, 3)")
+    if s.reference_range is not None and np.shape(s.reference_range) != (n_stops,):
+        raise ProductError(f"{where}: reference_range must have {n_stops} values")
 
 
 def _write_static(f: h5py.File, s: Scan) -> None:
@@ -90,7 +105,8 @@ def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None,
     """Validate and write a complete scan atomically."""
     _validate(s, str(path))
     n_stops = s.n_stops
-    with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
+    version = SCHEMA_VERSION if s.is_rail else SCHEMA_VERSION_TRACK
+    with atomic_h5(path, PRODUCT_TYPE, version, parameters, inputs) as f:
         _write_static(f, s)
         f.attrs["n_planned"] = s.n_planned if s.n_planned is not None else n_stops
         f.attrs["n_complete"] = n_stops
@@ -102,13 +118,18 @@ def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None,
         dataset(f, "stop_time", np.asarray(st, np.float64), units="s")
         fl = s.stop_flags if s.stop_flags is not None else np.zeros(n_stops, np.uint8)
         dataset(f, "stop_flags", np.asarray(fl, np.uint8), units="1")
+        if s.antenna_position is not None:
+            dataset(f, "antenna_position", np.asarray(s.antenna_position, np.float64), units="m")
+        if s.reference_range is not None:
+            dataset(f, "reference_range", np.asarray(s.reference_range, np.float64), units="m")
 
 
 def read_scan(path: str | os.PathLike) -> Scan:
     """Read a scan (only its ``n_complete`` valid stops); a malformed file raises ProductError."""
     with open_product(path, PRODUCT_TYPE) as f:
-        if attr_str(f, "schema_version") != SCHEMA_VERSION:
-            raise ProductError(f"{path}: unsupported gbsar_scan schema version")
+        version = attr_str(f, "schema_version")
+        if version not in (SCHEMA_VERSION, SCHEMA_VERSION_TRACK):
+            raise ProductError(f"{path}: unsupported gbsar_scan schema version {version}")
         n = int(f.attrs.get("n_complete", 0))
         s21 = require(f, "s21", path, shape_rank=3, dtype_kind="c")[:, :n, :]
         pols = tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p)
@@ -120,6 +141,12 @@ def read_scan(path: str | os.PathLike) -> Scan:
                     for k, v in f[name].attrs.items()}
 
         truth = read_mapping(f["truth"]) if "truth" in f else None
+        track = {}
+        if version == SCHEMA_VERSION_TRACK:
+            if "antenna_position" in f:
+                track["antenna_position"] = require(f, "antenna_position", path, shape_rank=2)[:n]
+            if "reference_range" in f:
+                track["reference_range"] = require(f, "reference_range", path, shape_rank=1)[:n]
         s = Scan(
             s21=s21,
             frequency=require(f, "frequency", path, shape_rank=1)[()],
@@ -136,6 +163,7 @@ def read_scan(path: str | os.PathLike) -> Scan:
             source=attr_str(f, "source", "unknown"),
             status=attr_str(f, "status", "unknown"),
             n_planned=int(f.attrs.get("n_planned", n)),
+            **track,
         )
     _validate(s, str(path))
     return s

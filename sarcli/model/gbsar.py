@@ -1,12 +1,16 @@
 """GB-SAR models: the rail site, the antenna, a scan (one frequency sweep per rail stop), a focused image.
 
 Phase convention: a scatterer at one-way range R from the antenna phase centre gives
-``S21 ~ exp(-j 4 pi f R / c)``; an image pixel at R0 carries ``-4 pi R0 / lam``. File layouts:
-``sarcli.io.scan`` and ``sarcli.io.gbsar_image``.
+``S21 ~ exp(-j 4 pi f R / c)``; an image pixel at R0 carries ``-4 pi R0 / lam``. A scan may instead
+hold one sweep per 3-D antenna position (``antenna_position``, e.g. an airborne phase history) and a
+reference range per sweep (``reference_range`` r_ref: the sweep was de-ramped / motion-compensated to
+it, ``S21 ~ exp(-j 4 pi f (R - r_ref) / c)``); such scans are focused on a grid (``grid_z_m``), where a
+scatterer focuses to its complex amplitude. File layouts: ``sarcli.io.scan`` and ``sarcli.io.gbsar_image``.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,7 +41,14 @@ class Antenna:
 
 @dataclass
 class Scan:
-    """In-memory GB-SAR scan. ``s21`` is (n_pol, n_stops, n_freq) complex64."""
+    """In-memory GB-SAR scan. ``s21`` is (n_pol, n_stops, n_freq) complex64.
+
+    A rail scan has antenna phase centres ``(rail_position, 0, rail_height)`` in the scan frame (x
+    along the rail, y horizontal towards the scene, z up). ``antenna_position`` (n_stops, 3) m, when
+    given, replaces them with any 3-D track in a local Cartesian frame (then ``rail_position`` is the
+    distance travelled along the track and ``rail_height`` its z). ``reference_range`` (n_stops,) m,
+    when given, is the range each sweep's phase is referenced to (module docstring).
+    """
 
     s21: np.ndarray
     frequency: np.ndarray
@@ -54,10 +65,24 @@ class Scan:
     source: str = "simulated"
     status: str = "simulated"
     n_planned: int | None = None
+    antenna_position: np.ndarray | None = None
+    reference_range: np.ndarray | None = None
 
     @property
     def n_stops(self) -> int:
         return int(self.s21.shape[1])
+
+    @property
+    def is_rail(self) -> bool:
+        """True for a straight-rail scan in absolute range (no 3-D track, no reference range)."""
+        return self.antenna_position is None and self.reference_range is None
+
+    def antenna_xyz(self) -> np.ndarray:
+        """(n_stops, 3) float64 antenna phase centres in the scan frame (class docstring)."""
+        if self.antenna_position is not None:
+            return np.asarray(self.antenna_position, np.float64)
+        x = np.asarray(self.rail_position, np.float64)
+        return np.stack([x, np.zeros_like(x), np.asarray(self.rail_height, np.float64)], axis=1)
 
     def pol(self, name: str) -> np.ndarray:
         """(n_stops, n_freq) S21 of one polarization."""
@@ -68,6 +93,13 @@ class Scan:
 
 @dataclass
 class GbsarImage:
+    """A focused image. Rail images (``grid_z_m`` None) lie in the slant plane of the rail: rows
+    ``range_m`` (R0, distance from the rail line), columns ``azimuth_m`` (x along the rail), phase
+    ``-4 pi R0/lam`` at a scatterer. Grid images (``grid_z_m`` a height) lie in the horizontal plane
+    z = grid_z_m of the scan frame: rows ``range_m`` hold y, columns ``azimuth_m`` hold x, and a
+    scatterer focuses to its complex amplitude. ``permittivity``: relative permittivity of the medium
+    the waves travelled in (speed c/sqrt(eps)); ranges are geometric metres in that medium."""
+
     image: np.ndarray
     range_m: np.ndarray
     azimuth_m: np.ndarray
@@ -84,6 +116,8 @@ class GbsarImage:
     scan_time_s: float
     site: Site = field(default_factory=Site)
     report: dict[str, Any] = field(default_factory=dict)
+    permittivity: float = 1.0
+    grid_z_m: float | None = None
 
     def pol(self, name: str) -> np.ndarray:
         if name not in self.polarizations:
@@ -92,4 +126,5 @@ class GbsarImage:
 
     @property
     def wavelength_m(self) -> float:
-        return C_LIGHT / self.center_frequency_hz
+        """Centre wavelength in the medium, c / (f_c sqrt(eps))."""
+        return C_LIGHT / (self.center_frequency_hz * math.sqrt(self.permittivity))

@@ -28,6 +28,7 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "gbsar_coherence": "sarcli.workflows.gbsar_coherence",
     "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
     "gbsar_focus": "sarcli.workflows.gbsar_focus",
+    "gbsar_import": "sarcli.workflows.gbsar_import",
     "gbsar_interfere": "sarcli.workflows.gbsar_interfere",
     "gbsar_plan": "sarcli.workflows.gbsar_plan",
     "gbsar_polarimetry": "sarcli.workflows.gbsar_polarimetry",
