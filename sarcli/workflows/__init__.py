@@ -21,9 +21,12 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "gbsar_emulate": "sarcli.workflows.gbsar_emulate",
     "gbsar_focus": "sarcli.workflows.gbsar_focus",
     "gbsar_interfere": "sarcli.workflows.gbsar_interfere",
+    "gbsar_monitor": "sarcli.workflows.gbsar_monitor",
     "gbsar_plan": "sarcli.workflows.gbsar_plan",
     "gbsar_polarimetry": "sarcli.workflows.gbsar_polarimetry",
     "gbsar_repeat": "sarcli.workflows.gbsar_repeat",
     "gbsar_scan": "sarcli.workflows.gbsar_scan",
+    "gbsar_series": "sarcli.workflows.gbsar_series",
+    "gbsar_serve": "sarcli.workflows.gbsar_serve",
     "gbsar_simulate": "sarcli.workflows.gbsar_simulate",
 })
