@@ -54,10 +54,11 @@ def inverse_velocity_forecast(t_h: np.ndarray, v: np.ndarray) -> tuple[float, fl
     iv = 1.0 / np.abs(np.asarray(v, np.float64))
     if t.size < 3 or not np.all(np.isfinite(iv)):
         return None
+    ss = float(np.sum((iv - iv.mean()) ** 2))
+    if not ss > 1e-12 * float(np.sum(iv * iv)):  # 1/v constant to rounding: no trend at all
+        return None
     m, q = np.polyfit(t, iv, 1)
     if not m < 0:
         return None
-    pred = m * t + q
-    ss = float(np.sum((iv - iv.mean()) ** 2))
-    r2 = 1.0 - float(np.sum((iv - pred) ** 2)) / ss if ss > 0 else 1.0
+    r2 = 1.0 - float(np.sum((iv - (m * t + q)) ** 2)) / ss
     return float(-q / m), float(m), r2

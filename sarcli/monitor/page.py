@@ -181,9 +181,9 @@ def _map_svg(uri: str, static: Static, cfg: MonitorConfig, title: str, unit: str
     grad = np.linspace(1, 0, 64)[:, None] * np.ones((1, 6))
     bar = colour_map(grad * (vmax - vmin) + vmin, np.ones(grad.shape, bool), grad, vmin, vmax, diverging)[::-1]
     parts.append(f'<image href="{data_uri(bar)}" x="{bx}" y="{mt}" width="12" height="{ph}" '
-                 f'preserveAspectRatio="none"/><text x="{bx + 15}" y="{mt + 9}" class="cb">{_fmt(vmax)}</text>'
-                 f'<text x="{bx + 15}" y="{mt + ph}" class="cb">{_fmt(vmin)}</text>'
-                 f'<text x="{bx + 15}" y="{mt + ph / 2}" class="cb">{html.escape(unit)}</text></svg>')
+                 f'preserveAspectRatio="none"/><text x="{bx + 15}" y="{mt + 9}" class="cb">{vmax:.3g}</text>'
+                 f'<text x="{bx + 15}" y="{mt + ph}" class="cb">{vmin:.3g}</text>'
+                 f'<text x="{bx + 15}" y="{mt + ph / 2 + 14}" class="cb">{html.escape(unit)}</text></svg>')
     return "".join(parts)
 
 
@@ -212,8 +212,8 @@ def _geocoded(static: Static, values: np.ndarray, show: np.ndarray, background: 
     ticks_n = "".join(f'<text x="42" y="{22 + (1 - (y - n0) / (n1 - n0)) * ph + 4:.1f}" class="yt">{_fmt(y)}</text>'
                       for y in _nice_ticks(n0, n1, 5))
     return (f'<svg class="map" viewBox="0 0 {width} {ph + 52}" width="{width}" height="{ph + 52}" role="img" '
-            f'aria-label="geocoded displacement"><text x="46" y="14" class="ct">displacement (mm), local east/north '
-            f'(m) about {site.latitude_deg:.5f}, {site.longitude_deg:.5f}</text>'
+            f'aria-label="geocoded displacement"><text x="46" y="14" class="ct">displacement, east/north (m) about '
+            f'{site.latitude_deg:.4f}, {site.longitude_deg:.4f}</text>'
             f'<image href="{data_uri(rgba)}" x="46" y="22" width="{pw}" height="{ph}" preserveAspectRatio="none"/>'
             f'<rect x="46" y="22" width="{pw}" height="{ph}" class="frame"/>{ticks_e}{ticks_n}'
             f'<text x="{46 + pw / 2}" y="{ph + 49}" class="xl">east (m)</text></svg>')

@@ -139,7 +139,9 @@ def run(config: Config, provenance=None, progress: Progress | None = None,
         else:
             import multiprocessing
 
-            ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+            # forkserver: a fork of a process that ran OpenMP (numba, BLAS) is unsafe; spawn where no forkserver
+            ctx = multiprocessing.get_context("forkserver" if "forkserver" in multiprocessing.get_all_start_methods()
+                                              else "spawn")
             with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
                 pending: deque[tuple[int, Future]] = deque()
                 todo = iter(rest)
