@@ -52,3 +52,29 @@ def offline_campaign(tmp_path_factory) -> Path:
     scans = tuple(sorted((root / "scans").glob("scan_*.h5")))
     gbsar_series.run(gbsar_series.Config(inputs=scans, config=MONITOR, out=root, jobs=1))
     return root
+
+
+def snapshot(root: Path) -> dict:
+    """Everything the store holds, comparable with ==: each epoch's record and maps, the state's arrays
+    and bookkeeping, alarms.csv (provenance attributes such as creation times are left out)."""
+    import h5py
+
+    from sarcli.monitor.store import Store
+
+    st = Store(root)
+    out: dict = {"alarms": st.alarms.read_text()}
+    for p in sorted(st.epochs.glob("scan_*.h5")):
+        with h5py.File(p, "r") as f:
+            out[p.name] = (f.attrs["record"], {k: _canon(f[k][()]) for k in f})
+    with h5py.File(st.state_path, "r") as f:
+        out["state"] = (f.attrs["meta"], {k: _canon(f[k][()]) for k in f if isinstance(f[k], h5py.Dataset)},
+                        {k: _canon(f["static"][k][()]) for k in f["static"]}, f["static"].attrs["meta"])
+    return out
+
+
+def _canon(a):
+    """An array as bytes with every NaN the same (NaN != NaN would make equal stores differ)."""
+    a = np.asarray(a)
+    if a.dtype.kind in "fc":
+        a = np.where(np.isnan(a), np.nan, a)
+    return (a.dtype.str, a.shape, a.tobytes())
