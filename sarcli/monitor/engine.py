@@ -228,13 +228,14 @@ def _stable(cfg: MonitorConfig, st: Static, s: State, selected: np.ndarray) -> n
 
 
 def _forecast(cfg: MonitorConfig, st: Static, ast: AreaState, t_h: float) -> dict[str, Any] | None:
-    """The inverse-velocity forecast of an area when its acceleration persists (ForecastSection)."""
+    """The inverse-velocity forecast of an area when its acceleration persists (ForecastSection); a
+    negative ``time_to_failure_h`` means the line has already reached zero: failure is imminent."""
     fc = cfg.forecast
     v = np.array(ast.run_v)
     if v.size < fc.window_scans or not np.all(np.isfinite(v)) or not np.all(v >= fc.min_velocity_mm_per_h):
         return None
     res = inverse_velocity_forecast(np.array(ast.run_t), v)
-    if res is None or res[2] < fc.min_r2 or res[0] < t_h:
+    if res is None or res[2] < fc.min_r2:
         return None
     return {"failure_utc": utc(st.t_ref + res[0] * 3600), "failure_h": res[0], "time_to_failure_h": res[0] - t_h,
             "r2": res[2], "n_samples": int(v.size)}
