@@ -264,7 +264,9 @@ def first_scan(cfg: MonitorConfig, st: Static, image: np.ndarray, index: int, ti
            "aps_residual_mm": None, "raw_stable_rms_mm": None, "aps_refractivity_ppm": None, "aps_model": "none",
            "max_velocity_mm_per_h": None, "alarm_level": "none", "alarm_area": None,
            "displacement_mm": {w.name: 0.0 for w in cfg.watch}, "velocity_mm_per_h": {w.name: None for w in cfg.watch},
-           "areas": {a.name: {"level": "none", "n_points": 0} for a in cfg.areas}, "unwrapping": "reference",
+           "areas": {a.name: {"level": "none", "n_points": 0, "displacement_mm": None, "velocity_mm_per_h": None,
+                              "acceleration_mm_per_h2": None, "forecast": None} for a in cfg.areas},
+           "unwrapping": "reference",
            "implausible_fraction": 0.0, "coherence_median": None, "time_h": 0.0, "meteo": meteo}
     s.chart.append(0.0, {"meteo_refractivity_ppm": (meteo or {}).get("refractivity_ppm", math.nan),
                          **{f"d:{w.name}": 0.0 for w in cfg.watch}})

@@ -94,17 +94,20 @@ def pixel_heights(dem_path: str | Path, img: GbsarImage, iterations: int = 6) ->
         ds = rasterio.open(dem_path)
     except rasterio.errors.RasterioIOError as e:
         raise ConfigError(f"[aps] dem: cannot read {dem_path} ({e})") from None
+    site = img.site
     with ds:
         band = ds.read(1, masked=True).astype(np.float64).filled(np.nan)
-        crs = ds.crs.to_string() if ds.crs else ""
+        crs = ds.crs.to_dict() if ds.crs else {}
+        epsg = ds.crs.to_epsg() if ds.crs else None
         inv = ~ds.transform
-    site = img.site
     utm = None
-    if ds.crs is not None and ds.crs.to_epsg() == utm_epsg(site):
+    ortho = (crs.get("proj") == "ortho" and abs(crs.get("lat_0", 1e9) - site.latitude_deg) < 1e-7
+             and abs(crs.get("lon_0", 1e9) - site.longitude_deg) < 1e-7)
+    if epsg == utm_epsg(site):
         utm, _ = enu_to_utm_affine(site, float(img.range_m[-1]) + float(np.ptp(img.azimuth_m)))
-    elif "ortho" not in crs:
-        raise ConfigError(f"[aps] dem: {dem_path} must be in the site's local east/north frame (+proj=ortho, as "
-                          f"'gbsar focus --enu-geotiff' writes) or in UTM EPSG:{utm_epsg(site)}; it is in '{crs}'")
+    elif not ortho:
+        raise ConfigError(f"[aps] dem: {dem_path} must be in the site's local east/north frame (+proj=ortho about "
+                          f"the site, as 'gbsar focus --enu-geotiff' writes) or in UTM EPSG:{utm_epsg(site)}")
     rr, xx = np.meshgrid(img.range_m, img.azimuth_m, indexing="ij")
     z = np.zeros(rr.shape)
     for _ in range(iterations):
