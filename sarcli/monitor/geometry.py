@@ -117,7 +117,8 @@ def pixel_heights(dem_path: str | Path, img: GbsarImage, iterations: int = 6) ->
             my = utm.a[1, 0] * e + utm.a[1, 1] * n + utm.b[1]
         else:
             mx, my = e, n
-        col, row = inv * (np.nan_to_num(mx, nan=-1e12), np.nan_to_num(my, nan=-1e12))
+        mx, my = np.nan_to_num(mx, nan=-1e12), np.nan_to_num(my, nan=-1e12)
+        col, row = inv.a * mx + inv.b * my + inv.c, inv.d * mx + inv.e * my + inv.f
         ci, ri = np.floor(col).astype(np.int64), np.floor(row).astype(np.int64)
         ok = np.isfinite(e) & (ri >= 0) & (ri < band.shape[0]) & (ci >= 0) & (ci < band.shape[1])
         z = np.full(rr.shape, np.nan)
