@@ -129,8 +129,8 @@ def main() -> None:
         shutil.rmtree(work, ignore_errors=True)
     load1 = os.getloadavg()[0]
     md = ["# bench_monitor: campaign store, incremental update and rebuild\n\n",
-          f"Load average {load0:.1f} -> {load1:.1f} on the shared 2-core machine (wall times are pessimistic and vary with the load; "
-          "CPU times are this process's).\n\n",
+          f"Load average {load0:.1f} -> {load1:.1f} on the shared 2-core machine (wall times are pessimistic and "
+          "vary with the load; CPU times are this process's).\n\n",
           f"## Incremental update vs scans stored ({N_SCANS} scans, grid {inc['grid'][0]} x {inc['grid'][1]}, "
           f"{inc['n_points']} points at the end)\n\n",
           "Per scan: update + epoch file + alarm log + state commit (fsync + rename) + live page; median of each "
