@@ -21,7 +21,8 @@ import os
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, require
+from sarcli.io.h5common import atomic_h5, attr_json, attr_number, attr_str, dataset, group, open_product, read_array
+from sarcli.io.scan import read_attr_group
 from sarcli.model.gbsar import GbsarImage, Site
 
 PRODUCT_TYPE = "gbsar_image"
@@ -52,22 +53,21 @@ def write_gbsar_image(path: str | os.PathLike, img: GbsarImage, parameters: dict
 
 
 def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
+    """Read and validate (:meth:`GbsarImage.validate`) an image product; ProductError (one line) otherwise."""
     with open_product(path, PRODUCT_TYPE) as f:
         if attr_str(f, "schema_version") != SCHEMA_VERSION:
             raise ProductError(f"{path}: unsupported gbsar_image schema version")
         missing = [k for k in _SCALARS if k not in f.attrs]
         if missing:
             raise ProductError(f"{path}: malformed gbsar_image, missing attribute(s) {', '.join(missing)}")
-        vals = {k: (attr_str(f, k) if k in ("algorithm", "epoch_utc") else f.attrs[k].item()) for k in _SCALARS}
-        site = Site(**{k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
-                       for k, v in f["site"].attrs.items()}) if "site" in f else Site()
+        vals = {k: (attr_str(f, k) if k in ("algorithm", "epoch_utc") else attr_number(f, k, integer=k == "n_freq"))
+                for k in _SCALARS}
         img = GbsarImage(
-            image=require(f, "image", path, shape_rank=3, dtype_kind="c")[()],
-            range_m=require(f, "range", path, shape_rank=1)[()],
-            azimuth_m=require(f, "azimuth", path, shape_rank=1)[()],
-            algorithm_map=require(f, "algorithm_map", path, shape_rank=2)[()],
+            image=read_array(f, "image", "c", ndim=3, finite=False),
+            range_m=read_array(f, "range", "f", ndim=1, finite=False),
+            azimuth_m=read_array(f, "azimuth", "f", ndim=1, finite=False),
+            algorithm_map=read_array(f, "algorithm_map", "iu", ndim=2),
             polarizations=tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p),
-            site=site, report=json.loads(attr_str(f, "report") or "{}"), **vals)
-    if img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size) or img.image.shape[0] != len(img.polarizations):
-        raise ProductError(f"{path}: malformed gbsar_image, image shape does not match its axes")
+            site=read_attr_group(f, "site", Site), report=attr_json(f, "report", {}), **vals)
+    img.validate(str(path))
     return img
