@@ -75,13 +75,13 @@ class Radar:
         tau = ck.number(w, "pulse_length_s", self.pulse_length_s, lo=0.0, unit="s")
         if k == 0.0 or tau == 0.0:
             raise ProductError(f"{w}: chirp_rate_hz_per_s and pulse_length_s must be non-zero")
-        if abs(k) * tau > fs * (1.0 + 1e-9):
-            raise ProductError(f"{w}: chirp band |K| tau = {abs(k) * tau / 1e6:.6g} MHz exceeds the sampling "
-                               f"rate {fs / 1e6:.6g} MHz (the samples would alias)")
         window = 0.0 if n_samples is None else n_samples / fs
         if tau + window >= 1.0 / prf:
             raise ProductError(f"{w}: pulse ({tau * 1e6:.6g} us) plus receive window ({window * 1e6:.6g} us) "
                                f"exceed the pulse interval 1/PRF = {1e6 / prf:.6g} us")
+        if abs(k) * tau > fs * (1.0 + 1e-9):
+            raise ProductError(f"{w}: chirp band |K| tau = {abs(k) * tau / 1e6:.6g} MHz exceeds the sampling "
+                               f"rate {fs / 1e6:.6g} MHz (the samples would alias)")
         ws = ck.number(w, "window_start_s", self.window_start_s, lo=0.0, hi=1.0, unit="s")
         r0 = ck.number(w, "first_range_m", self.first_range_m, *FIRST_RANGE_M, unit="m")
         if abs(r0 - C_LIGHT * ws / 2.0) > RANGE_WINDOW_RTOL * r0 + 1.0:
