@@ -120,6 +120,7 @@ def atomic_h5(
             f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
+    _probed.add(_version_key(path))  # written here and now: reading it back needs no probe
 
 
 def dataset(
@@ -172,17 +173,155 @@ def _h5_reason(e: BaseException) -> str:
     return f"{e.__class__.__name__}: {msg[:160]}" if msg else e.__class__.__name__
 
 
+#: Seconds a metadata probe may take (a small product's metadata read in milliseconds; a damaged one
+#: can send the HDF5 library into an endless loop, e.g. a global-heap object size bit-flipped).
+PROBE_TIMEOUT_S = 20.0
+_probed: set[tuple] = set()
+
+
+def _version_key(path: str | os.PathLike) -> tuple[int, int, int, int]:
+    st = os.stat(path)
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def _walk_metadata(path: Path) -> None:
+    """Read every attribute and every dataset's shape, type and chunk index (no data): what a reader
+    touches before the samples."""
+    with h5py.File(path, "r") as f:
+        def visit(obj: Any) -> None:
+            for k in obj.attrs:
+                obj.attrs[k]
+            if isinstance(obj, h5py.Dataset):
+                obj.shape, obj.dtype  # noqa: B018
+                if obj.chunks is not None:
+                    obj.id.get_num_chunks()
+        visit(f)
+        f.visititems(lambda name, obj: visit(obj))
+
+
+def probe_metadata(path: str | os.PathLike) -> None:
+    """Refuse (one line) an HDF5 file whose metadata send the HDF5 library into a hang or a crash.
+
+    A hang in C code cannot be interrupted from Python, so the metadata are first walked
+    (:func:`_walk_metadata`) in another process that is killed after :data:`PROBE_TIMEOUT_S`; errors
+    the walk meets are left to the caller, which meets them again in-process and reports them. The
+    walk runs in a child forked by a small helper interpreter (:func:`_probe_server`, started once per
+    process): forking the caller itself would copy its threads' locks (numba, OpenMP, h5py's own) into
+    the child and cost tens of milliseconds. Once per file version (device, inode, size, modification
+    time) and process; a no-op where ``fork`` is not available.
+    """
+    key = _version_key(path)
+    if key in _probed or not hasattr(os, "fork"):
+        return
+    verdict = _PROBER.ask(os.path.abspath(path), PROBE_TIMEOUT_S)
+    if verdict == "hang":
+        raise ProductError(f"{path}: damaged HDF5 product: reading its metadata does not finish "
+                           f"(given up after {PROBE_TIMEOUT_S:g} s)")
+    if verdict != "ok":
+        raise ProductError(f"{path}: damaged HDF5 product: reading its metadata crashes the HDF5 library"
+                           f" ({verdict})")
+    _probed.add(key)
+
+
+def _probe_server() -> None:  # pragma: no cover - runs in the helper interpreter
+    """The helper's loop: one JSON request ``[timeout_s, path]`` per line on stdin, one verdict per line
+    on stdout: ``ok``, ``hang`` (the walk was killed after the timeout) or ``signal N`` / ``died``."""
+    import select
+    import signal
+    import sys
+
+    for line in sys.stdin:
+        timeout, path = json.loads(line)
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            try:
+                os.close(r)
+                with contextlib.suppress(BaseException):
+                    _walk_metadata(Path(path))
+                os.write(w, b"done")
+            finally:
+                os._exit(0)
+        os.close(w)
+        ready, _, _ = select.select([r], [], [], timeout)
+        answer = os.read(r, 16) if ready else b""
+        os.close(r)
+        if not ready:
+            os.kill(pid, signal.SIGKILL)
+        _, status = os.waitpid(pid, 0)
+        if answer == b"done":
+            verdict = "ok"
+        elif not ready:
+            verdict = "hang"
+        else:
+            verdict = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else "died"
+        sys.stdout.write(verdict + "\n")
+        sys.stdout.flush()
+
+
+class _Prober:
+    """The caller's side of the helper interpreter (started on first use, restarted if it dies)."""
+
+    def __init__(self) -> None:
+        import threading
+
+        self.proc: Any = None
+        self.lock = threading.Lock()
+
+    def _start(self) -> None:
+        import subprocess
+        import sys
+
+        code = (f"import sys; sys.path[:0] = {sys.path!r}; "
+                "from sarcli.io.h5common import _probe_server; _probe_server()")
+        self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     text=True, bufsize=1)
+
+    def _stop(self) -> None:
+        if self.proc is not None:
+            with contextlib.suppress(OSError):
+                self.proc.kill()
+                self.proc.wait()
+        self.proc = None
+
+    def ask(self, path: str, timeout: float) -> str:
+        import select
+
+        with self.lock:
+            if self.proc is None or self.proc.poll() is not None:
+                self._start()
+            try:
+                self.proc.stdin.write(json.dumps([timeout, path]) + "\n")
+                self.proc.stdin.flush()
+                ready, _, _ = select.select([self.proc.stdout], [], [], timeout + 30.0)
+                line = self.proc.stdout.readline() if ready else ""
+            except BaseException:  # interrupted mid-request: its answer would be read by the next one
+                self._stop()
+                raise
+            if not line:  # the helper itself hung or died: start afresh next time
+                self._stop()
+                return "hang" if not ready else "helper died"
+            return line.strip()
+
+
+_PROBER = _Prober()
+
+
 @contextlib.contextmanager
 def open_product(path: str | os.PathLike, product_type: str | Sequence[str] | None = None,
                  mode: str = "r") -> Iterator[h5py.File]:
     """Open an existing product, refusing (one line) a missing, non-HDF5 or wrong-type file.
 
-    Inside the block, any error that h5py raises (a truncated or damaged file: OSError, KeyError,
-    RuntimeError, ...) becomes one :class:`ProductError` line naming the file.
+    The file's metadata are probed first in a child process (:func:`probe_metadata`): a damaged file
+    that would hang or crash the HDF5 library is refused in one line. Inside the block, any error that
+    h5py raises (a truncated or damaged file: OSError, KeyError, RuntimeError, ...) becomes one
+    :class:`ProductError` line naming the file.
     """
     path = Path(path)
     if not path.exists():
         raise ProductError(f"{path}: no such file")
+    if path.is_file():
+        probe_metadata(path)
     try:
         f = h5py.File(path, mode)
     except Exception as e:  # h5py: OSError for a non-HDF5/truncated file, others for damaged superblocks
