@@ -333,3 +333,52 @@ def test_uniform_tolerance_is_relative_to_the_step():
     ck.uniform("f", "t", t + np.r_[0, 0, 0, 0.09e-3, 0, 0, 0, 0, 0, 0], 1e-3, 0.1)
     with pytest.raises(ProductError, match="step 2 is 0.00111"):
         ck.uniform("f", "t", t + np.r_[0, 0, 0, 0.11e-3, 0, 0, 0, 0, 0, 0], 1e-3, 0.1)
+
+
+# --- HDF5 files that hang the library -----------------------------------------------------------------
+
+def _hanging_product(path):
+    """Two text attributes live in a global heap; XOR 7 into the second object's size (byte 1 of the
+    8-byte size at collection + 16 (header) + 16 (first object's header) + 16 (its 10 bytes, padded)
+    + 8 (second object's index, reference count, reserved)) sends HDF5 1.14 into an endless loop."""
+    with h5py.File(path, "w", libver=("earliest", "v110")) as f:
+        f.attrs["product_type"] = "gbsar_scan"
+        f.attrs["schema_version"] = "1"
+    data = bytearray(path.read_bytes())
+    heap = data.find(b"GCOL")
+    assert heap > 0 and data[heap + 32:heap + 42] == b"gbsar_scan"
+    data[heap + 57] ^= 7
+    path.write_bytes(bytes(data))
+
+
+def test_a_file_that_hangs_the_hdf5_library_is_refused(tmp_path, monkeypatch):
+    from sarcli.io import h5common
+
+    monkeypatch.setattr(h5common, "PROBE_TIMEOUT_S", 2.0)
+    path = tmp_path / "scan.h5"
+    _hanging_product(path)
+    with pytest.raises(ProductError, match="reading its metadata does not finish"):
+        read_scan(path)
+
+
+def test_probe_runs_once_per_file_version(tmp_path, monkeypatch):
+    from sarcli.io import h5common
+
+    asked = []
+    real = h5common._PROBER.ask
+    monkeypatch.setattr(h5common._PROBER, "ask", lambda p, t: asked.append(p) or real(p, t))
+    path = tmp_path / "scan.h5"
+    with h5py.File(path, "w") as f:  # written by another tool: probed on first read
+        f.attrs["product_type"] = "gbsar_scan"
+    for _ in range(3):
+        with h5common.open_product(path):
+            pass
+    assert len(asked) == 1
+    with h5py.File(path, "r+") as f:  # a new version of the file is probed again
+        f.attrs["x"] = 1.0
+    with h5common.open_product(path):
+        pass
+    assert len(asked) == 2
+    write_scan(tmp_path / "own.h5", _scan())  # what this process wrote needs no probe
+    read_scan(tmp_path / "own.h5")
+    assert len(asked) == 2
