@@ -107,16 +107,25 @@ def increasing(where: str, name: str, a: np.ndarray, strict: bool = True) -> np.
     return a
 
 
-def uniform(where: str, name: str, a: np.ndarray, step: float | np.ndarray, rtol: float) -> np.ndarray:
-    """A 1-D array whose consecutive differences equal ``step`` (scalar or one per difference) to ``rtol``."""
+def uniform(where: str, name: str, a: np.ndarray, step: float | np.ndarray, rtol: float,
+            gaps: bool = False) -> np.ndarray:
+    """A 1-D array whose consecutive differences equal ``step`` (scalar or one per difference) to ``rtol``.
+
+    ``gaps``: a difference may also be a whole number k >= 2 of steps (missing samples kept as a gap),
+    within ``rtol`` of one step, as long as the median difference is one step (so a step mislabelled
+    by a factor of two or more is still refused)."""
     if a.size > 1:
-        d = np.diff(a)
-        err = np.abs(d / step - 1.0)
-        if not np.all(err <= rtol):
-            k = int(np.argmax(~(err <= rtol)))
-            s = float(np.broadcast_to(step, d.shape)[k])
-            raise ProductError(f"{where}: {name} is not uniform: step {k} is {d[k]:.6g}, expected {s:.6g} "
-                               f"within {100 * rtol:g} %")
+        ratio = np.diff(a) / step
+        k = np.maximum(np.round(ratio), 1.0) if gaps else np.ones_like(ratio)
+        bad = ~(np.abs(ratio - k) <= rtol)
+        if bad.any():
+            i = int(np.argmax(bad))
+            s = float(np.broadcast_to(step, ratio.shape)[i])
+            raise ProductError(f"{where}: {name} is not uniform: step {i} is {ratio[i] * s:.6g}, expected "
+                               f"{'a whole multiple of ' if gaps else ''}{s:.6g} within {100 * rtol:g} %")
+        if gaps and not abs(float(np.median(ratio)) - 1.0) <= rtol:
+            raise ProductError(f"{where}: {name} steps are {float(np.median(ratio)):.6g} times the expected "
+                               f"{float(np.median(np.broadcast_to(step, ratio.shape))):.6g} (median)")
     return a
 
 

@@ -26,7 +26,7 @@ CARRIER_HZ = (1.0e7, 1.0e12)  # 30 m .. 0.3 mm wavelength
 WAVELENGTH_RTOL = 1e-3  # wavelength_m * carrier_frequency_hz / c = 1 within this
 FIRST_RANGE_M = (1.0, 1.0e8)
 RANGE_WINDOW_RTOL = 1e-3  # first_range_m = c window_start_s / 2 within this (plus 1 m)
-AZIMUTH_TIME_RTOL = 0.1  # every line interval is 1/PRF (or 1/prf_per_line) within 10 %
+AZIMUTH_TIME_RTOL = 0.1  # every line interval is k/PRF (or k/prf_per_line), k >= 1, within 10 % of 1/PRF
 AGC_DB = (-200.0, 200.0)
 QUANTIZATION_BITS = (0, 32)
 SPEED_MPS = (1e-3, 1.2e4)  # platform speed of a LOCAL (flat-Earth) trajectory, and the nominal velocity
@@ -209,8 +209,10 @@ class RawProduct:
         ``read_raw(load_echo=False)`` returns it); then every check but the samples' finiteness runs, as
         it does with ``finite_samples=False``.
         Checks: the radar (:meth:`Radar.validate`); a complex (n_lines, n_samples) echo, finite when
-        loaded; azimuth times finite, strictly increasing and uniform: each interval is 1/PRF (or
-        1/prf_per_line of its line) within ``AZIMUTH_TIME_RTOL``; an ISO-8601 epoch; per-line arrays
+        loaded; azimuth times finite, strictly increasing and on the pulse grid: each interval is 1/PRF
+        (or 1/prf_per_line of its line) within ``AZIMUTH_TIME_RTOL``, or a whole number of them (lines
+        missing from the recording and kept as a gap, ``sarcli ingest --missing keep``) with the median
+        interval one pulse interval; an ISO-8601 epoch; per-line arrays
         (prf_per_line, agc_db) of one finite value per line; a finite 1-D replica; further channels
         shaped like the echo with one receiver offset per channel; the orbit and attitude.
         """
@@ -234,7 +236,7 @@ class RawProduct:
                 raise ProductError(f"{where}: prf_per_line has implausible values (expected {PRF_HZ[0]:g} .. "
                                    f"{PRF_HZ[1]:g} Hz)")
             step = 1.0 / prf[:-1]
-        ck.uniform(where, "azimuth_time", t, step, AZIMUTH_TIME_RTOL)
+        ck.uniform(where, "azimuth_time", t, step, AZIMUTH_TIME_RTOL, gaps=True)
         if self.agc_db is not None:
             agc = ck.array(where, "radar/agc_db", self.agc_db, "f", shape=(n_lines,))
             if np.any((agc < AGC_DB[0]) | (agc > AGC_DB[1])):

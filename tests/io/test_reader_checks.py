@@ -38,9 +38,9 @@ def _data(name, fn):
     return damage
 
 
-def _time_gap(t):
+def _time_gap(t, pulses=1.5):
     t = t.copy()
-    t[5:] += t[1] - t[0]  # one missing line: the interval 4 -> 5 is two PRIs
+    t[5:] += (pulses - 1) * (t[1] - t[0])  # the interval 4 -> 5 is `pulses` PRIs
     return t
 
 
@@ -72,7 +72,8 @@ RAW_DAMAGE = [
      r"azimuth_time has shape \(39,\), expected \(40,\)"),
     ("azimuth_time text", _data("azimuth_time", lambda t: t.astype("S24")), "azimuth_time has dtype"),
     ("azimuth_time reversed", _data("azimuth_time", lambda t: t[::-1].copy()), "azimuth_time must increase"),
-    ("azimuth_time gap", _data("azimuth_time", _time_gap), "azimuth_time is not uniform: step 4"),
+    ("azimuth_time off the pulse grid", _data("azimuth_time", _time_gap), "azimuth_time is not uniform: step 4"),
+    ("azimuth_time PRF halved", _data("azimuth_time", lambda t: 2 * t), "azimuth_time steps are 2 times"),
     ("agc NaN", _data("radar/agc_db", lambda a: np.r_[a[:3], np.nan, a[4:]].astype(np.float32)),
      "radar/agc_db contains NaN"),
     ("agc short", _data("radar/agc_db", lambda a: a[:-2]), "radar/agc_db has shape"),
@@ -129,6 +130,14 @@ def test_damaged_raw_refused_in_one_line(raw_path, damage, msg):
         with pytest.raises(ProductError, match=msg) as e:
             read_raw(raw_path, load_echo=load_echo)
         assert "\n" not in str(e.value) and str(raw_path) in str(e.value)
+
+
+def test_missing_lines_kept_as_a_gap_are_a_valid_product(tmp_path, make_raw):
+    """`sarcli ingest --missing keep`: a gap of whole pulse intervals is allowed (the median is one PRI)."""
+    p = make_raw()
+    p.azimuth_time = _time_gap(p.azimuth_time, pulses=4.0)
+    write_raw(tmp_path / "gap.h5", p)
+    assert np.isclose(np.diff(read_raw(tmp_path / "gap.h5").azimuth_time)[4] * p.radar.prf_hz, 4.0)
 
 
 def test_nan_echo_is_refused_only_when_the_samples_are_read(raw_path):
