@@ -237,6 +237,7 @@ def _probe_server() -> None:  # pragma: no cover - runs in the helper interprete
         if pid == 0:
             try:
                 os.close(r)
+                signal.alarm(int(timeout) + 2)  # SIGALRM's default action ends the walk even if the helper died
                 with contextlib.suppress(BaseException):
                     _walk_metadata(Path(path))
                 os.write(w, b"done")
@@ -266,6 +267,7 @@ class _Prober:
         import threading
 
         self.proc: Any = None
+        self.registered = False
         self.lock = threading.Lock()
 
     def _start(self) -> None:
@@ -276,13 +278,26 @@ class _Prober:
                 "from sarcli.io.h5common import _probe_server; _probe_server()")
         self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      text=True, bufsize=1)
+        if not self.registered:
+            import atexit
+
+            atexit.register(self._stop)
+            self.registered = True
 
     def _stop(self) -> None:
-        if self.proc is not None:
-            with contextlib.suppress(OSError):
-                self.proc.kill()
-                self.proc.wait()
-        self.proc = None
+        """End the helper (its loop ends with its stdin; killed if it does not within a second)."""
+        proc, self.proc = self.proc, None
+        if proc is None:
+            return
+        with contextlib.suppress(OSError):
+            proc.stdin.close()
+        try:
+            proc.wait(timeout=1.0)
+        except Exception:
+            proc.kill()
+            proc.wait()
+        with contextlib.suppress(OSError):
+            proc.stdout.close()
 
     def ask(self, path: str, timeout: float) -> str:
         import select
