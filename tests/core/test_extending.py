@@ -86,7 +86,7 @@ def test_recipe_focuser(recipe, cli, tmp_path):
     raw = scene([(r0, 0.2, 1.0)], n_lines=300, n_samples=400, fdc=0.0, replica=True)
     write_raw(tmp_path / "raw.h5", raw)
     r = cli("focus", tmp_path / "raw.h5", "-o", tmp_path / "rc.h5", "--algorithm", "range-only",
-            "--set", "block_lines=64")
+            "--fdc", "0", "--fr", "-2000", "--set", "block_lines=64")
     assert r.exit_code == 0, r.stderr
     img = read_slc(tmp_path / "rc.h5").image
     line = int(np.argmax(np.abs(img).max(axis=1)))
