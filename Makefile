@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 DEMO   := demo
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.numba_cache
+WARM   := $(VENV)/warm-up
 
 .PHONY: install demo test test-fast bench lint clean
 
@@ -14,6 +14,16 @@ $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[dev]'
+	@# compile the numba kernels of the main commands into the per-user cache (sarcli/__init__.py), so
+	@# that the first command after install loads them instead of compiling (docs/validation.md)
+	@rm -rf $(WARM) && mkdir -p $(WARM)
+	$(BIN)/sarcli -q simulate samples/rs1_point.toml -o $(WARM)/raw.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
+	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5
+	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
+	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
+	@rm -rf $(WARM)
 	@touch $@
 
 install: $(STAMP)
@@ -80,4 +90,4 @@ $(OUT)/%.slc.h5 $(OUT)/%.tif $(OUT)/%.png: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5
 .PRECIOUS: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5 $(OUT)/%.slc.h5
 
 clean:
-	rm -rf $(DEMO) .pytest_cache .hypothesis .numba_cache
+	rm -rf $(DEMO) .pytest_cache .hypothesis
