@@ -45,12 +45,18 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
 }
 
 
+_LOADED: dict[str, tuple[typer.Typer, Any]] = {}
+
+
 def load_command(name: str) -> Any:
-    """The command (or command group) ``name`` of :data:`COMMANDS`, its modules imported now."""
-    sub = make_typer()
-    for module in COMMANDS[name][0]:
-        importlib.import_module(f"sarcli.cli.commands.{module}").register(sub)
-    return typer.main.get_group(sub).commands[name]
+    """The command (or command group) ``name`` of :data:`COMMANDS`, its modules imported on first use.
+    (The Typer app it was registered on is kept alive: ``gbsar_app.attach`` remembers apps by id.)"""
+    if name not in _LOADED:
+        sub = make_typer()
+        for module in COMMANDS[name][0]:
+            importlib.import_module(f"sarcli.cli.commands.{module}").register(sub)
+        _LOADED[name] = (sub, typer.main.get_group(sub).commands[name])
+    return _LOADED[name][1]
 
 
 class LazyGroup(SarcliGroup):
