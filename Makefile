@@ -8,14 +8,20 @@ STAMP  := $(VENV)/.installed-stamp
 DEMO   := demo
 WARM   := $(VENV)/warm-up
 
-.PHONY: install demo test test-fast bench lint clean
+.PHONY: install warm-cache demo test test-fast bench lint clean
 
 $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[dev]'
-	@# compile the numba kernels of the main commands into the per-user cache (sarcli/__init__.py), so
-	@# that the first command after install loads them instead of compiling (docs/validation.md)
+	@$(MAKE) --no-print-directory warm-cache
+	@touch $@
+
+install: $(STAMP)
+
+## warm-cache: compile the numba kernels of the main commands into the per-user cache (sarcli/__init__.py)
+##   on small samples, so that the first command after install loads them instead of compiling (run by install)
+warm-cache:
 	@rm -rf $(WARM) && mkdir -p $(WARM)
 	$(BIN)/sarcli -q simulate samples/rs1_point.toml -o $(WARM)/raw.h5
 	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
@@ -24,9 +30,6 @@ $(STAMP): pyproject.toml
 	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
 	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
 	@rm -rf $(WARM)
-	@touch $@
-
-install: $(STAMP)
 
 ## demo: the main job on the embedded default sample (see README "Demo")
 demo: $(STAMP)
