@@ -65,7 +65,7 @@ def _commands(work: Path, f: dict[str, Path]) -> dict[str, list[str]]:
     }
 
 
-def section_warm(work: Path, f: dict[str, Path], out: dict, rounds: int = 7) -> str:
+def section_warm(work: Path, f: dict[str, Path], out: dict, rounds: int = 5) -> str:
     cmds = _commands(work, f)
     for c in cmds.values():  # fill the numba cache, warm the page cache
         _run(c)
