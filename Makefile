@@ -10,14 +10,15 @@ DEMO   := demo
 LOCK   := requirements/constraints.txt
 LOCK_VENV ?= $(VENV)
 LATEST := .venv-latest
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.numba_cache
+WARM   := $(VENV)/warm-up
 
-.PHONY: install demo test test-latest lock bench lint clean
+.PHONY: install warm-cache demo test test-latest lock bench lint clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q -c $(LOCK) --upgrade pip
 	$(BIN)/python -m pip install -q -c $(LOCK) -e '.[dev]'
+	@$(MAKE) --no-print-directory warm-cache
 	@touch $@
 
 install: $(STAMP)
@@ -43,6 +44,18 @@ test-latest:
 	$(LATEST)/bin/python -m pip install -q --upgrade -e '.[dev]'
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache-latest $(LATEST)/bin/python .ci/test_latest.py --lock $(LOCK) \
 	  -- -q -n 2 --dist loadfile
+
+## warm-cache: compile the numba kernels of the main commands into the per-user cache (sarcli/__init__.py)
+##   on small samples, so that the first command after install loads them instead of compiling (run by install)
+warm-cache:
+	@rm -rf $(WARM) && mkdir -p $(WARM)
+	$(BIN)/sarcli -q simulate samples/rs1_point.toml -o $(WARM)/raw.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
+	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5
+	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
+	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
+	@rm -rf $(WARM)
 
 ## demo: the main job on the embedded default sample (see README "Demo")
 demo: $(STAMP)
@@ -107,3 +120,4 @@ $(OUT)/%.slc.h5 $(OUT)/%.tif $(OUT)/%.png: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5
 
 clean:
 	rm -rf $(DEMO) .pytest_cache .hypothesis .numba_cache .numba_cache-latest $(LATEST)
+	rm -rf $(DEMO) .pytest_cache .hypothesis
