@@ -38,9 +38,10 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
     "simulate": (("simulate",), "Simulate the raw echoes of a stripmap scene; only the effects the scene lists "
                                 "are computed."),
     "ati": (("ati",), "SAR along-track interferometry: detect, estimate, compensate ground movers."),
-    "gbsar": (("gbsar_acquisition", "gbsar_processing"), "Ground-based SAR: simulate, plan, focus, interfere, "
-                                                         "coherence; acquire with a VNA and a rail."),
-    "optical": (("optical",), "Emulated acousto-optic / CCD real-time processor (seed 004)."),
+    "gbsar": (("gbsar_acquisition", "gbsar_monitoring", "gbsar_processing"),
+              "Ground-based SAR: simulate, import, plan, focus, interfere, coherence; acquire with a VNA and a rail; "
+              "monitor a slope."),
+    "optical": (("optical",), "Emulated acousto-optic / CCD real-time processor [KimAODCCD]."),
     "orbit": (("orbit_cmd",), "Orbit state vectors: summary, Hermite interpolation, accuracy/cost tables."),
 }
 
