@@ -202,8 +202,8 @@ def speckle_variance(quality: float, n_pairs: int, n_cols: int, rho: np.ndarray)
 def scene_variance(window_energy: np.ndarray, window_valid: np.ndarray, block_mean: float, quality: float,
                    block: BlockFactors, window: BlockFactors, lag_lines: int = SPECKLE_LAG) -> float:
     """Phase variance (rad^2) of one block's centroid from the scene's contrast, K(L) rho m2 / (rho mu)^2:
-    rho m2 from the line-pair energies of the extended window (``window_valid`` marks the lines that
-    start a pair), rho mu from the block's mean line energy and quality (module docstring); 0 when the
+    rho m2 from the line energies of the extended window (``window_valid`` marks the lines whose energy
+    is known), rho mu from the block's mean line energy and quality (module docstring); 0 when the
     line power shows no placement covariance, inf when the window is too short to tell it from its mean."""
     p = np.asarray(window_energy, np.float64)
     v = np.asarray(window_valid, bool)
@@ -225,9 +225,9 @@ def scene_variance(window_energy: np.ndarray, window_valid: np.ndarray, block_me
 def block_sigmas(bc: BlockCorrelation, pattern: Pattern) -> tuple[np.ndarray, np.ndarray]:
     """(speckle, scene) phase variances (rad^2) of every block of ``bc`` (with its ``line_energy``)."""
     n_all = bc.line_energy.shape[0]
-    starts = np.zeros(n_all, bool)  # lines that start a pair inside their block
+    covered = np.zeros(n_all, bool)  # lines of blocks that hold pairs (their energies are filled)
     for m0, n in zip(bc.line0, bc.n_lines, strict=True):
-        starts[m0:m0 + max(n - 1, 0)] = True
+        covered[m0:m0 + n] = n > 1
     rho = pattern.coherence(SPECKLE_LAGS)
     ext = int(np.ceil(pattern.null_lines))
     quality = bc.quality()
@@ -246,7 +246,7 @@ def block_sigmas(bc: BlockCorrelation, pattern: Pattern) -> tuple[np.ndarray, np
             q = float(quality[i, j])
             var_speckle[i, j] = speckle_variance(q, int(n) - 1, int(bc.n_samples[j]), rho) * (
                 SIGN_LOSS if bc.estimator == "sde" else 1.0)
-            block_mean = float(np.mean(bc.line_energy[m0:m0 + n - 1, j])) if n > 1 else 0.0
-            var_scene[i, j] = scene_variance(bc.line_energy[a:b, j], starts[a:b], block_mean, q, factors(int(n)),
+            block_mean = float(np.mean(bc.line_energy[m0:m0 + n, j])) if n > 1 else 0.0
+            var_scene[i, j] = scene_variance(bc.line_energy[a:b, j], covered[a:b], block_mean, q, factors(int(n)),
                                              factors(b - a))
     return var_speckle, var_scene

@@ -10,6 +10,13 @@ The stops are taken in increasing rail position (:func:`sarcli.gbsar.rail.ordere
 backwards focuses to the same image; a rail with unknown or repeated positions is refused).
 Options: :class:`FocusOptions`, a frozen configuration (``sarcli.config.from_mapping`` builds it
 from a table); windows are taper specs of :mod:`sarcli.gbsar.windows`.
+
+Grid mode (``grid_m`` = x0, x1, dx, y0, y1, dy[, z]): backprojection onto the horizontal plane z
+(default 0) of the scan frame, rows y, columns x (:func:`sarcli.gbsar.backprojection.backproject_grid`),
+from every sweep's antenna phase centre (a rail's ``(x_i, 0, h_i)``, or the scan's 3-D
+``antenna_position``) and its reference range; a scatterer focuses to its complex amplitude. Scans
+with a 3-D track or reference ranges can only be focused this way. ``permittivity``: the waves travel
+at c/sqrt(eps) (every algorithm; ranges are geometric metres in the medium).
 """
 
 from __future__ import annotations
@@ -21,15 +28,14 @@ from typing import Literal
 
 import numpy as np
 
-from sarcli.errors import ConfigError, SarcliError
-from sarcli.gbsar.backprojection import backproject
+from sarcli.errors import ConfigError, ProductError, SarcliError
+from sarcli.gbsar.backprojection import backproject, backproject_grid
 from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
 from sarcli.gbsar.rail import ordered
-from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress
+from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress, wave_speed
 from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
 from sarcli.gbsar.windows import parse_taper
-from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import Scan
 
 ALGORITHMS = ("auto", "df", "rd", "bp")
@@ -45,6 +51,35 @@ class Grid:
 
 
 MIN_RANGE_BINS = 4  # an image shallower than this many range bins is a mistake, not a product
+MAX_GRID_PIXELS = 100_000_000  # a grid larger than this (0.8 GB per polarization) is a typo, not an image
+
+
+@dataclass(frozen=True)
+class PlaneGrid:
+    """Horizontal grid of the scan frame: columns ``xs``, rows ``ys`` (m), at height ``z`` (m)."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    z: float
+
+    @classmethod
+    def from_spec(cls, spec: tuple[float, ...]) -> PlaneGrid:
+        """``(x0, x1, dx, y0, y1, dy[, z])``: x0, x0 + dx, ... up to x1 (included when on the lattice),
+        the same for y; z default 0. One-line :class:`ConfigError` for anything else."""
+        if len(spec) not in (6, 7) or not all(math.isfinite(v) for v in spec):
+            raise ConfigError(f"--grid needs six or seven finite numbers x0,x1,dx,y0,y1,dy[,z] (m), got "
+                              f"{','.join(f'{v:g}' for v in spec) or 'nothing'}")
+        x0, x1, dx, y0, y1, dy = spec[:6]
+        axes = []
+        for name, a, b, d in (("x", x0, x1, dx), ("y", y0, y1, dy)):
+            if not d > 0 or b < a:
+                raise ConfigError(f"--grid: {name} runs from {a:g} to {b:g} m in steps of {d:g} m; the step must "
+                                  f"be > 0 and the end >= the start")
+            axes.append(a + d * np.arange(math.floor((b - a) / d + 1e-9) + 1))
+        if axes[0].size * axes[1].size > MAX_GRID_PIXELS:
+            raise ConfigError(f"--grid has {axes[1].size} x {axes[0].size} pixels (more than {MAX_GRID_PIXELS:.0e}): "
+                              "use larger steps or a smaller area")
+        return cls(xs=axes[0], ys=axes[1], z=float(spec[6]) if len(spec) == 7 else 0.0)
 
 
 def _positive(name: str, flag: str, value: float | None, what: str) -> None:
@@ -61,7 +96,10 @@ class FocusOptions:
     pixel's aperture); ``max_range_m``/``min_range_m``: image rows; ``pixel_x_m`` (a multiple of the
     rail step), ``width_m``: image columns; ``criterion_rad``: the eq. 12 phase-error criterion;
     ``n_xfft``: azimuth FFT size of DF/RD; ``*_oversample``: range (and DF azimuth) FFT oversampling;
-    ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect.
+    ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect;
+    ``grid_m``: (x0, x1, dx, y0, y1, dy[, z]) backprojects onto that horizontal grid instead (module
+    docstring; ``auto`` means BP there, and the slant-grid options must stay unset);
+    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
@@ -79,6 +117,8 @@ class FocusOptions:
     df_oversample: int = 2
     beam_limited: bool = True
     rd_reference: Literal["sinc", "rect"] = "sinc"
+    grid_m: tuple[float, ...] = ()
+    permittivity: float = 1.0
 
     def __post_init__(self) -> None:
         if self.algorithm not in ALGORITHMS:
@@ -101,17 +141,36 @@ class FocusOptions:
         for name in ("bp_oversample", "rd_oversample", "df_oversample"):
             if getattr(self, name) < 1:
                 raise ConfigError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not (math.isfinite(self.permittivity) and self.permittivity >= 1.0):
+            raise ConfigError(f"--permittivity must be a relative permittivity >= 1, got {self.permittivity:g}")
+        if self.grid_m:
+            self.plane_grid()
+            if self.algorithm not in ("bp", "auto"):
+                raise ConfigError(f"--grid is a backprojection grid: use --algorithm bp, not {self.algorithm}")
+            slant = [flag for flag, value in (("--max-range", self.max_range_m), ("--pixel-x", self.pixel_x_m),
+                                              ("--width", self.width_m), ("--n-xfft", self.n_xfft))
+                     if value is not None] + (["--min-range"] if self.min_range_m else [])
+            if slant:
+                raise ConfigError(f"{', '.join(slant)} shape the slant-plane grid; with --grid the grid says it all")
+
+    def plane_grid(self) -> PlaneGrid:
+        """The ``grid_m`` grid (module docstring)."""
+        return PlaneGrid.from_spec(tuple(float(v) for v in self.grid_m))
 
 
 def check_range_interval(scan: Scan, opts: FocusOptions) -> None:
     """Refuse a range interval that holds fewer than MIN_RANGE_BINS range bins, before any focusing.
 
     The bin is the range-compression sample spacing ``c / (2 N df)``, ``N = 2^ceil(log2 N_f)``
-    (N_Rfft of Table 1); ranges stop at R_max = c / (4 df).
+    (N_Rfft of Table 1); ranges stop at R_max = c / (4 df) (c/sqrt(eps) in a medium). Nothing to check
+    on a ``grid_m`` grid (it is checked when the options are made).
     """
+    if opts.grid_m:
+        return
     df = check_sweep(scan.frequency)
-    dr = C_LIGHT / (2 * next_pow2(scan.frequency.size) * df)
-    r_max = C_LIGHT / (4 * df)
+    v = wave_speed(opts.permittivity)
+    dr = v / (2 * next_pow2(scan.frequency.size) * df)
+    r_max = v / (4 * df)
     lo, hi = opts.min_range_m, opts.max_range_m
     if lo > r_max - MIN_RANGE_BINS * dr:
         raise ConfigError(f"--min-range {lo:g} m leaves fewer than {MIN_RANGE_BINS} range bins below the "
@@ -162,7 +221,7 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
 
 
 def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> np.ndarray:
-    prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample)
+    prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
     return backproject(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
                        opts.azimuth_window)
@@ -171,7 +230,7 @@ def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
     """DF with range and azimuth FFTs ``df_oversample`` times Table 1's sizes (finer polar grid for the
     bilinear geometric correction; 1 = the paper's N_Rfft x N_xfft), on BP's amplitude normalization."""
-    prof = range_compress(scan, pol, opts.range_window, opts.df_oversample, opts.max_range_m)
+    prof = range_compress(scan, pol, opts.range_window, opts.df_oversample, opts.max_range_m, opts.permittivity)
     n = opts.n_xfft or next_pow2(scan.rail_position.size) * opts.df_oversample
     pol_img = focus_df(prof, n, opts.azimuth_window)
     part, cov = geometric_correction(pol_img, grid.ranges[rows], grid.azimuths, prof.wavelength_m)
@@ -182,7 +241,7 @@ def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
 def _rd(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions, antenna_length_m: float,
         n_xfft: int | None) -> tuple[np.ndarray, np.ndarray, int]:
     prof = range_compress(scan, pol, opts.range_window, opts.rd_oversample,
-                          max_range_m=float(grid.ranges[rows][-1]) * 1.05 + 1.0)
+                          max_range_m=float(grid.ranges[rows][-1]) * 1.05 + 1.0, permittivity=opts.permittivity)
     img = focus_rd(prof, antenna_length_m, n_xfft, opts.azimuth_window,
                    max_range_m=float(grid.ranges[rows][-1]) + 1e-9, reference=opts.rd_reference)
     ri = np.rint(grid.ranges[rows] / img.ranges_m[1]).astype(np.int64) if img.ranges_m.size > 1 else \
@@ -199,12 +258,19 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     """Focus every polarization of ``scan`` (or ``pols``) with ``opts.algorithm``; report the choices.
 
     The stops are focused in increasing rail position (:func:`sarcli.gbsar.rail.ordered`); the
-    report's ``skipped_stops`` are indices of the input scan."""
+    report's ``skipped_stops`` are indices of the input scan. With ``opts.grid_m``:
+    :func:`focus_grid` (``grid`` unused)."""
     opts = opts or FocusOptions()
+    if opts.grid_m:
+        return focus_grid(scan, opts, pols)
+    if not scan.is_rail:
+        what = "3-D antenna positions" if scan.antenna_position is not None else "reference ranges"
+        raise ConfigError(f"this scan has {what} (not a straight rail in absolute range): focus it on a grid "
+                          "with --algorithm bp --grid x0,x1,dx,y0,y1,dy[,z]")
     scan, order = ordered(scan)
     pols = pols or scan.polarizations
     lx = scan.antenna.length_azimuth_m
-    prof0 = range_compress(scan, pols[0], opts.range_window, 1, opts.max_range_m)
+    prof0 = range_compress(scan, pols[0], opts.range_window, 1, opts.max_range_m, opts.permittivity)
     if np.all(prof0.weights == 0):
         raise SarcliError("every rail stop is flagged or holds NaN: nothing to focus")
     grid = grid or default_grid(prof0, lx, opts)
@@ -256,6 +322,8 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
         "n_xfft": n_xfft_used, "seconds": timings, "polarizations": list(pols),
         "range_window": opts.range_window, "azimuth_window": opts.azimuth_window,
     }
+    if opts.permittivity != 1.0:
+        report["permittivity"] = opts.permittivity
     if opts.algorithm == "auto" and not uniform:
         report["note"] = "non-uniform rail steps: DF/RD impossible, the whole image was backprojected"
     df_ranges = grid.ranges[alg_plan["df"]] if "df" in alg_plan else np.zeros(0)
@@ -267,13 +335,64 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     return Focused(image=image, grid=grid, algorithm_map=amap, report=report)
 
 
+def _track(scan: Scan) -> np.ndarray:
+    """The scan's antenna phase centres, refused in one line when focusing cannot use them."""
+    a = scan.antenna_xyz()
+    bad = ~np.all(np.isfinite(a), axis=1)
+    if scan.reference_range is not None:
+        bad |= ~np.isfinite(np.asarray(scan.reference_range, np.float64))
+    if np.any(bad):
+        idx = np.flatnonzero(bad)
+        raise ProductError(f"the antenna position or reference range of sweep(s) {', '.join(map(str, idx[:5]))}"
+                           f"{f' (and {idx.size - 5} more)' if idx.size > 5 else ''} is not finite: their geometry "
+                           "is unknown, so the scan cannot be focused")
+    if scan.n_stops < 2 or np.all(a == a[0]):
+        raise ProductError(f"the scan's {scan.n_stops} sweep(s) were measured from one antenna position: there "
+                           "is no synthetic aperture to focus")
+    return a
+
+
+def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = None) -> Focused:
+    """Backproject every polarization onto the horizontal grid ``opts.grid_m`` (module docstring);
+    ``Focused.grid`` holds y in ``ranges`` and x in ``azimuths``; ``algorithm_map`` is 3 where some
+    sweep's profile covered the pixel. The report gives the grid, the share of pixels that every sweep
+    covered (``full_aperture_fraction``: pixels outside lie beyond some sweep's unambiguous range
+    window [-R_max, R_max) about its reference range) and the skipped sweeps."""
+    plane = opts.plane_grid()
+    ant = _track(scan)
+    pols = pols or scan.polarizations
+    image = np.zeros((len(pols), plane.ys.size, plane.xs.size), np.complex64)
+    t0 = time.perf_counter()
+    for ip, pol in enumerate(pols):
+        prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity,
+                              centred=True)
+        if np.all(prof.weights == 0):
+            raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
+        image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
+                                           opts.azimuth_window)
+    amap = np.where(frac > 0, ALG_CODE["bp"], 0).astype(np.uint8)
+    report = {
+        "algorithm": opts.algorithm, "used": {"bp": [float(plane.ys[0]), float(plane.ys[-1])]},
+        "grid": {"x_m": [float(plane.xs[0]), float(plane.xs[-1])], "y_m": [float(plane.ys[0]), float(plane.ys[-1])],
+                 "dx_m": float(opts.grid_m[2]), "dy_m": float(opts.grid_m[5]), "z_m": plane.z},
+        "n_sweeps": scan.n_stops, "track": "rail" if scan.antenna_position is None else "3-D",
+        "reference_range": scan.reference_range is not None,
+        "unambiguous_range_m": [float(prof.first_range_m), float(-prof.first_range_m)],
+        "full_aperture_fraction": float(np.mean(frac >= 1.0 - 1e-9)),
+        "skipped_stops": list(prof.skipped), "seconds": {"bp": time.perf_counter() - t0},
+        "polarizations": list(pols), "range_window": opts.range_window, "azimuth_window": opts.azimuth_window,
+        "footprint_antenna_length_m": None, "permittivity": opts.permittivity,
+    }
+    return Focused(image=image, grid=Grid(ranges=plane.ys, azimuths=plane.xs), algorithm_map=amap, report=report)
+
+
 def image_from_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None = None,
                     pols: tuple[str, ...] | None = None):
     """Focus ``scan`` and wrap the result as a :class:`sarcli.io.gbsar_image.GbsarImage` product."""
     from sarcli.model.gbsar import GbsarImage
 
     opts = opts or FocusOptions()
-    f = focus_scan(scan, opts, grid, pols)  # checked the rail: finite, >= 2 distinct positions
+    f = focus_scan(scan, opts, grid, pols)  # checked the rail (or track): finite, >= 2 distinct positions
     fr, x = scan.frequency, np.sort(np.asarray(scan.rail_position, np.float64))
     return GbsarImage(image=f.image, range_m=f.grid.ranges, azimuth_m=f.grid.azimuths, algorithm_map=f.algorithm_map,
                       polarizations=tuple(f.report["polarizations"]), algorithm=opts.algorithm,
@@ -282,4 +401,5 @@ def image_from_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | N
                       rail_height_m=float(np.mean(scan.rail_height)), rail_centre_m=float(0.5 * (x[0] + x[-1])),
                       rail_length_m=float(x[-1] - x[0]), epoch_utc=scan.epoch_utc,
                       scan_time_s=float(np.mean(scan.stop_time)) if scan.stop_time is not None else 0.0,
-                      site=scan.site, report=f.report)
+                      site=scan.site, report=f.report, permittivity=opts.permittivity,
+                      grid_z_m=opts.plane_grid().z if opts.grid_m else None)

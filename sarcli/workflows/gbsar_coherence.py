@@ -31,7 +31,7 @@ from sarcli.io.gbsar_image import open_gbsar_image, write_gbsar_image
 from sarcli.io.interferogram import write_ps
 from sarcli.model.gbsar import GbsarImage
 from sarcli.workflows.base import Progress, Report, no_progress, using
-from sarcli.workflows.gbsar_common import focus_on_the_fly, guard, is_scan, parameters, slant_extent
+from sarcli.workflows.gbsar_common import focus_on_the_fly, guard, is_scan, parameters, rail_image, slant_extent
 
 BLOCK_BYTES = 64 * 1024 * 1024  # working memory of one block of every image (complex64 and temporaries)
 
@@ -97,7 +97,7 @@ def _open_all(stack: contextlib.ExitStack, paths: tuple[Path, ...], output: Path
             focused = Path(tmp) / f"{k}.h5"
             write_gbsar_image(focused, focus_on_the_fly(p, like=imgs[0] if imgs else None))
             p = focused
-        imgs.append(stack.enter_context(open_gbsar_image(p)))
+        imgs.append(rail_image(stack.enter_context(open_gbsar_image(p)), paths[k]))
     return imgs
 
 

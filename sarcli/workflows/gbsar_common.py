@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from sarcli.config import to_mapping
-from sarcli.errors import ConfigError
+from sarcli.errors import ConfigError, ProductError
 from sarcli.model.gbsar import GbsarImage
 from sarcli.workflows.base import refuse_overwriting_inputs
 
@@ -67,13 +67,27 @@ def focus_on_the_fly(path: str | os.PathLike, like: GbsarImage | None = None) ->
     return image_from_scan(read_scan(path), grid=grid)
 
 
+def rail_image(img: GbsarImage, path: str | os.PathLike) -> GbsarImage:
+    """``img`` if it is a rail slant-plane image focused in air; interferometry, coherence and
+    polarimetry (their phase models, footprint masks and map outputs) assume that geometry, so a
+    ``--grid`` or ``--permittivity`` image is refused in one line."""
+    if img.grid_z_m is not None:
+        raise ProductError(f"{path} is a grid image (gbsar focus --grid): interfere, coherence and polarimetry "
+                           "work on rail slant-plane images")
+    if img.permittivity != 1.0:
+        raise ProductError(f"{path} was focused in a medium (--permittivity {img.permittivity:g}): interfere, "
+                           "coherence and polarimetry work on images focused in air")
+    return img
+
+
 def load_image(path: str | os.PathLike, like: GbsarImage | None = None) -> GbsarImage:
-    """A focused image product, or a scan focused on the fly (:func:`focus_on_the_fly`)."""
+    """A focused rail image product (:func:`rail_image`), or a scan focused on the fly
+    (:func:`focus_on_the_fly`)."""
     if is_scan(path):
         return focus_on_the_fly(path, like)
     from sarcli.io.gbsar_image import read_gbsar_image
 
-    return read_gbsar_image(path)
+    return rail_image(read_gbsar_image(path), path)
 
 
 def slant_extent(img: GbsarImage) -> list[float]:

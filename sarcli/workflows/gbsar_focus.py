@@ -6,6 +6,13 @@ azimuth x along it); its phase at a scatterer is ``-4 pi R0/lam`` for every algo
 that can be refused is refused before any focusing: an output that is the input, a missing output
 folder, an impossible range interval (:func:`sarcli.gbsar.focus.check_range_interval`), an absent
 polarization, a rail focusing cannot use (:func:`sarcli.gbsar.rail.ordered`).
+
+With ``grid_m`` (``--grid x0,x1,dx,y0,y1,dy[,z]``) the scan is backprojected onto that horizontal grid
+of its own frame instead (x along the rail or the data's local x, y across, z up; for an imported
+phase history such as GOTCHA, the scene-centred frame of its antenna positions), which is how scans
+with 3-D antenna positions or reference ranges are focused; such an image has no map geometry
+(``--geotiff``/``--enu-geotiff`` are refused) and its quicklook has y up. ``permittivity``: waves at
+c/sqrt(eps) (a ground-penetrating scan; image range = distance in the medium, e.g. depth).
 """
 
 from __future__ import annotations
@@ -15,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from sarcli.errors import ConfigError
 from sarcli.gbsar.focus import FocusOptions, check_range_interval, image_from_scan
 from sarcli.gbsar.geocode import resample_to_map
 from sarcli.io.gbsar_image import write_gbsar_image
@@ -49,17 +57,22 @@ class Config:
     map_pixel_m: float | None = None
     ground_height_m: float = 0.0
     quicklook: Path | None = None
+    grid_m: tuple[float, ...] | None = None
+    permittivity: float = 1.0
 
     def __post_init__(self) -> None:
         self.options()  # every option checked when the configuration is made, before any file is opened
         object.__setattr__(self, "pols", tuple(p.upper() for p in self.pols))
+        if self.grid_m and (self.geotiff or self.enu_geotiff):
+            raise ConfigError("a --grid image lies in the scan's own local frame, which has no map geometry: "
+                              "drop --geotiff/--enu-geotiff (use --quicklook)")
 
     def options(self) -> FocusOptions:
         return FocusOptions(algorithm=self.algorithm, range_window=self.range_window,
                             azimuth_window=self.azimuth_window, max_range_m=self.max_range_m,
                             min_range_m=self.min_range_m, pixel_x_m=self.pixel_x_m, width_m=self.width_m,
                             criterion_rad=criterion_rad(self.criterion_deg), near=self.near, n_xfft=self.n_xfft,
-                            rd_reference=self.rd_reference)
+                            rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity)
 
 
 @dataclass
@@ -77,6 +90,13 @@ class GbsarFocusReport(Report):
         return to_jsonable(self.focus)
 
     def lines(self) -> list[str]:
+        g = self.focus.get("grid")
+        if g is not None:
+            return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, bp on the grid x "
+                    f"{g['x_m'][0]:g}..{g['x_m'][1]:g} m, y {g['y_m'][0]:g}..{g['y_m'][1]:g} m at z {g['z_m']:g} m "
+                    f"from {self.focus['n_sweeps']} sweeps ({self.focus['track']} track"
+                    f"{', reference ranges' if self.focus['reference_range'] else ''}); "
+                    f"{100 * self.focus['full_aperture_fraction']:.0f} % of the pixels seen by every sweep"]
         used = ", ".join(f"{k} {a:.2f}-{b:.2f} m" for k, (a, b) in self.focus["used"].items())
         return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, {used} "
                 f"(DF minimum range {self.focus['df_min_range_m']:.2f} m)"]
@@ -95,7 +115,12 @@ def image_outputs(img: GbsarImage, config: Config) -> dict[str, Any]:
         out[f"{frame}_geotiff"] = {"path": str(path), "crs": crs, "shape": list(raster.shape), **ginfo}
         write_geotiff(path, raster, crs, transform=transform, band_description=f"{img.polarizations[0]} amplitude (dB)",
                       tags={"algorithm": img.algorithm, "epoch_utc": img.epoch_utc, "units": "dB"})
-    if config.quicklook is not None:
+    if config.quicklook is not None and img.grid_z_m is not None:  # rows are y: draw them y up, 1 m = 1 m
+        write_quicklook(config.quicklook, img.image[0][::-1],
+                        title=f"{img.polarizations[0]} backprojection, z = {img.grid_z_m:g} m",
+                        extent=[img.azimuth_m[0], img.azimuth_m[-1], img.range_m[0], img.range_m[-1]],
+                        xlabel="x (m)", ylabel="y (m)", aspect="equal")
+    elif config.quicklook is not None:
         write_quicklook(config.quicklook, img.image[0], title=f"GB-SAR {img.polarizations[0]} ({img.algorithm})",
                         extent=slant_extent(img), xlabel="azimuth x (m)", ylabel="range R0 (m)", aspect="auto")
     return out

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sarcli.errors import ConfigError
 from sarcli.gbsar.rail import ordered
 from sarcli.gbsar.scene import load_scene
 from sarcli.gbsar.system import System, azimuth_resolution, build_system
@@ -78,7 +79,11 @@ def system(config: Config) -> System:
         f, x, lx = sc.frequencies(), sc.positions_m, sc.antenna.length_azimuth_m
         max_range = config.max_range_m if config.max_range_m is not None else sc.processing.get("max_range_m")
     else:
-        s, _ = ordered(read_scan(config.source))
+        s = read_scan(config.source)
+        if not s.is_rail:
+            raise ConfigError(f"{config.source} has 3-D antenna positions or reference ranges: plan derives the "
+                              "straight-rail system table (seed 000 Table 1), which does not apply to it")
+        s, _ = ordered(s)
         f, x, lx, max_range = s.frequency, s.rail_position, s.antenna.length_azimuth_m, config.max_range_m
     return build_system(f, x, lx, max_range, crit)
 

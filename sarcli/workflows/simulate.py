@@ -23,12 +23,14 @@ _log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class Config:
-    """scene: scene file (TOML); output: raw product (hdf5) or a folder (ceos); format: hdf5 or ceos;
-    compression: HDF5 compression of the echo; seed: overrides the scene's seed."""
+    """scene: scene file (TOML); output: raw product (hdf5), a folder (ceos) or a packet file (s1-l0);
+    format: hdf5, ceos (Radarsat-1 CEOS RAW) or s1-l0 (Sentinel-1 Level-0 packets, FDBAQ; the scene's
+    range sampling rate must be a Sentinel-1 rate); compression: HDF5 compression of the echo; seed:
+    overrides the scene's seed."""
 
     scene: Path
     output: Path
-    format: Literal["hdf5", "ceos"] = "hdf5"
+    format: Literal["hdf5", "ceos", "s1-l0"] = "hdf5"
     compression: Literal["gzip", "lzf"] | None = None
     seed: int | None = None
 
@@ -71,6 +73,33 @@ def check_ceos_scene(sc: Any) -> None:
                         r.range_sampling_rate_hz, r.prf_hz, r.window_start_s)
 
 
+#: RMS of the echo written as Level-0 samples, in ADC levels: a Level-0 packet carries the digitizer's
+#: levels, the simulator's amplitude unit is arbitrary; 32 levels keeps the BAQ/FDBAQ quantizers in their
+#: design range (their threshold tables span sigma of about 1 to 1000 levels) for any simulated power.
+S1_ECHO_RMS_LEVELS = 32.0
+
+
+def write_s1_level0(path: Path, raw: Any) -> None:
+    """The simulated echo as Sentinel-1 Level-0 packets (FDBAQ), scaled to :data:`S1_ECHO_RMS_LEVELS`;
+    an inertial (ECI) orbit is rotated to the Earth-fixed frame the packets carry (GMST, ``orbit.frames``)."""
+    import dataclasses
+
+    import numpy as np
+
+    from orbit.frames import eci_to_ecef
+    from sarcli.io.sentinel1.product import write_level0
+    from sarcli.model.raw import Orbit
+
+    o = raw.orbit
+    if o is not None and o.frame == "ECI":
+        p, v = eci_to_ecef(raw.epoch_utc, o.time, o.position, o.velocity)
+        raw = dataclasses.replace(raw, orbit=Orbit(o.time, p, v, "ECEF"))
+    rms = float(np.sqrt(np.mean(np.abs(raw.echo.astype(np.complex128)) ** 2)))
+    if rms > 0:
+        raw = dataclasses.replace(raw, echo=(raw.echo * np.float32(S1_ECHO_RMS_LEVELS / rms)).astype(np.complex64))
+    write_level0(raw, path)
+
+
 def run(config: Config, provenance: base.Provenance | None = None, progress: base.Progress | None = None) -> Report:
     """Simulate the scene and write the product (module docstring)."""
     from sarcli.io.ceos.radarsat1 import SCENE_FILES
@@ -79,12 +108,13 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
 
     with base.using(provenance):
         output = Path(config.output)
-        written = [output] if config.format == "hdf5" else [output / name for name in SCENE_FILES]
+        written = [output / name for name in SCENE_FILES] if config.format == "ceos" else [output]
         base.refuse_overwriting_inputs([config.scene], [output] + (written if config.format == "ceos" else []))
         if not output.resolve().parent.is_dir():
             raise ConfigError(f"output folder {output.resolve().parent} does not exist: create it first")
-        if output.is_dir() and config.format == "hdf5":
-            raise ConfigError(f"{output} is a folder: give a file name for the raw product (or --format ceos)")
+        if output.is_dir() and config.format != "ceos":
+            raise ConfigError(f"{output} is a folder: give a file name for the {config.format} output "
+                              "(or --format ceos)")
         sc = load_scene(config.scene)
         if config.seed is not None:
             sc.seed = config.seed
@@ -108,6 +138,8 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
             from sarcli.io.ceos.radarsat1 import write_ceos
 
             write_ceos(output, raw)  # creates the folder only once the product is known to be representable
+        elif config.format == "s1-l0":
+            write_s1_level0(output, raw)
         else:
             params = {"scene": sc.name, "effects": list(sc.effects), "seed": sc.seed, "workflow": "simulate",
                       "config": {k: v for k, v in to_mapping(config).items() if k != "output"}}

@@ -29,6 +29,7 @@ def _stream(segments, nq=64, seed=0):
     h = E.blank_headers(n)
     t = 1276273467.0 + np.arange(n) * PRI_CODE / F_REF_HZ
     h["coarse_time"] = np.floor(t)
+    h["pri_count"] = np.arange(n)
     h["fine_time"] = np.floor((t - np.floor(t)) * 65536)
     h["ecc_number"], h["range_decimation"], h["polarisation"], h["swath_number"] = 13, 4, 7, 2
     h["rank"], h["pri"], h["swst"], h["swl"] = 10, PRI_CODE, 5271, 12178

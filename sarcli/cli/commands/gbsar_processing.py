@@ -1,4 +1,4 @@
-"""``sarcli gbsar simulate|plan|focus|interfere|coherence|polarimetry``: GB-SAR processing commands.
+"""``sarcli gbsar simulate|import|plan|focus|interfere|coherence|polarimetry``: GB-SAR processing commands.
 
 Each command parses its options into the ``Config`` of its workflow (``sarcli.workflows.gbsar_*``,
 imported inside the command so that ``--help`` stays fast), runs it and prints the report.
@@ -11,8 +11,19 @@ from pathlib import Path
 import typer
 
 from sarcli.cli.gbsar_app import attach, gbsar_app, run_workflow
+from sarcli.errors import ConfigError
 
 _WINDOW_HELP = "rect (or none) | hamming[:a] | hann | kaiser[:beta], as stripmap focus"
+
+
+def _numbers(flag: str, text: str | None) -> tuple[float, ...] | None:
+    """``"a,b,c"`` -> (a, b, c); one-line error for anything but numbers."""
+    if text is None:
+        return None
+    try:
+        return tuple(float(t) for t in text.split(","))
+    except ValueError:
+        raise ConfigError(f"{flag} takes comma-separated numbers, e.g. -50,50,0.1,-50,50,0.1; got {text!r}") from None
 
 
 @gbsar_app.command("simulate")
@@ -34,6 +45,53 @@ def simulate_cmd(
     from sarcli.workflows import gbsar_simulate as wf
 
     run_workflow(wf, wf.Config(scene=scene, output=output), json_out)
+
+
+@gbsar_app.command("import")
+def import_cmd(
+    files: list[Path] = typer.Argument(..., help="Sweep files of one format (.mat, .npz, .npy, .csv, .s1p, .s2p); "
+                                       "several are concatenated along the positions."),
+    output: Path = typer.Option(..., "-o", "--output", help="Output scan product (.h5)."),
+    data: str = typer.Option(None, "--data", help="Samples: a complex variable or RE,IM (dotted paths into MATLAB "
+                             "structs, e.g. data.fp); CSV: column(s); Touchstone: S11|S21|S12|S22 "
+                             "[default: usual names (fp, s21, data, ...); S21 for .s2p]."),
+    frequency: str = typer.Option(None, "--frequency", help="Frequencies (Hz) [default: freq, frequency, f, ...]."),
+    position: str = typer.Option(None, "--position", help="Antenna positions (m): one variable (n rail positions, or "
+                                 "n x 3) or X,Y,Z; Touchstone: START:STEP or a comma list, one per file "
+                                 "[default: position, pos, ..., or x,y,z]."),
+    reference_range: str = typer.Option(None, "--reference-range", help="Range (m) each sweep's phase is referenced "
+                                        "to, per sweep or one value [default: r0, R0, reference_range if present]."),
+    layout: str = typer.Option("auto", "--layout", help="auto | frequency-position | position-frequency (needed when "
+                               "the matrix is square)."),
+    pol: str = typer.Option(None, "--pol", help="Polarization VV|VH|HV|HH [default: from the file names, else VV]."),
+    height: float = typer.Option(0.0, "--height", help="Antenna height (m) of 1-D rail positions."),
+    antenna_length: float = typer.Option(None, "--antenna-length", help="Antenna length L_x (m) for the rail "
+                                         "focusers' beam footprint [default: 0.25]."),
+    epoch: str = typer.Option("2000-01-01T00:00:00Z", "--epoch", help="Scan epoch (ISO-8601 UTC)."),
+    json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
+) -> None:
+    """Import frequency sweeps (one per antenna position) into a scan product for `gbsar focus`.
+
+    A sample matrix is frequency x position or position x frequency: the layout is taken from the
+    lengths of the frequency and position vectors (the report says which). Positions are 1-D rail
+    positions or a 3-D track; a reference range per sweep (de-ramped, motion-compensated phase
+    histories) makes S21 ~ exp(-j*4*pi*f*(R - r_ref)/c). Focus 3-D or referenced scans with
+    `gbsar focus --algorithm bp --grid ...`.
+
+    Examples:
+
+      sarcli gbsar import ../shared/data/gotcha_pass1_hh/data_3dsar_pass1_az00?_HH.mat -o gotcha.h5
+
+      sarcli gbsar import sweeps.npz --data S --frequency f --position x --height 1.2 -o rail.h5
+
+      sarcli gbsar import stop_*.s2p --position 0:0.01 -o lab.h5
+    """
+    from sarcli.workflows import gbsar_import as wf
+
+    cfg = wf.Config(inputs=tuple(files), output=output, data=data, frequency=frequency, position=position,
+                    reference_range=reference_range, layout=layout, pol=pol, height_m=height,
+                    antenna_length_m=antenna_length, epoch_utc=epoch)
+    run_workflow(wf, cfg, json_out)
 
 
 @gbsar_app.command("plan")
@@ -83,6 +141,10 @@ def focus_cmd(
     map_pixel: float = typer.Option(None, "--map-pixel", help="Map pixel (m) of the GeoTIFFs [default: range pixel]."),
     ground_height: float = typer.Option(0.0, "--ground-height", help="Surface height z (m) for geocoding."),
     quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the slant-plane amplitude."),
+    grid: str = typer.Option(None, "--grid", help="x0,x1,dx,y0,y1,dy[,z] (m): backproject onto this horizontal "
+                             "grid of the scan's frame (z default 0) instead of the rail's slant plane."),
+    permittivity: float = typer.Option(1.0, "--permittivity", help="Relative permittivity of the medium: waves "
+                                       "travel at c/sqrt(EPS), image ranges are distances in it (e.g. depth)."),
     json_out: bool = typer.Option(False, "--json", help="Print the focusing report as JSON on stdout."),
 ) -> None:
     """Focus a scan: range compression, then DF, RD, BP or auto (DF beyond the eq. 12 limit, BP/RD nearer).
@@ -90,6 +152,9 @@ def focus_cmd(
     The image lies in the slant plane of the rail (range R0 from the rail line, azimuth x along it);
     its phase at a scatterer is -4*pi*R0/lambda for every algorithm. A scan measured with the rail
     moving backwards focuses to the same image; an output that is the input is refused.
+    With --grid, BP focuses onto a horizontal grid of the scan's frame (a rail: x along it, y across,
+    z up; an imported 3-D track: the data's own frame, for GOTCHA centred on the scene), from any
+    antenna track and reference ranges; a scatterer then focuses to its complex amplitude.
 
     Examples:
 
@@ -98,6 +163,10 @@ def focus_cmd(
       sarcli gbsar focus scan.h5 --algorithm rd --max-range 15 -o near.h5 --json
 
       sarcli gbsar focus scan.h5 -o kaiser.h5 --range-window kaiser:2.5 --azimuth-window hann
+
+      sarcli gbsar focus gotcha.h5 --algorithm bp --grid -50,50,0.1,-50,50,0.1 -o cars.h5 --quicklook cars.png
+
+      sarcli gbsar focus gpr.h5 --algorithm bp --permittivity 6 --max-range 2 -o depth.h5
     """
     from sarcli.workflows import gbsar_focus as wf
 
@@ -105,7 +174,8 @@ def focus_cmd(
                     min_range_m=min_range, pixel_x_m=pixel_x, width_m=width, criterion_deg=criterion_deg, near=near,
                     n_xfft=n_xfft, rd_reference=rd_reference, range_window=range_window,
                     azimuth_window=azimuth_window, geotiff=geotiff, enu_geotiff=enu_geotiff, map_pixel_m=map_pixel,
-                    ground_height_m=ground_height, quicklook=quicklook)
+                    ground_height_m=ground_height, quicklook=quicklook, grid_m=_numbers("--grid", grid),
+                    permittivity=permittivity)
     run_workflow(wf, cfg, json_out)
 
 

@@ -12,7 +12,8 @@ from sarcli.cli.common import emit_json, print_status, run_workflow
 def simulate(
     scene: Path = typer.Argument(..., help="Scene file (TOML): radar, antenna, platform, targets, effects."),
     output: Path = typer.Option(..., "-o", "--output", help="Raw product (HDF5) or, with --format ceos, a folder."),
-    fmt: str = typer.Option("hdf5", "--format", help="hdf5 (raw product) or ceos (Radarsat-1 leader + data)."),
+    fmt: str = typer.Option("hdf5", "--format", help="hdf5 (raw product), ceos (Radarsat-1 leader + data) or s1-l0 "
+                      "(Sentinel-1 Level-0 packets; needs a Sentinel-1 sampling rate, e.g. samples/s1_stripmap.toml)."),
     compression: str = typer.Option(None, "--compression", help="HDF5 compression of the echo (gzip, lzf)."),
     seed: int = typer.Option(None, "--seed", min=0, help="Override the scene's seed (Monte-Carlo runs)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
@@ -29,6 +30,8 @@ def simulate(
       sarcli simulate samples/rs1_point.toml -o raw.h5
 
       sarcli simulate samples/rs1_point.toml --format ceos -o demo/ceos
+
+      sarcli simulate samples/s1_stripmap.toml --format s1-l0 -o s1.dat
 
       sarcli simulate samples/ati_paper.toml -o ati.h5 --json
 

@@ -16,7 +16,9 @@ Geometry and timing [S1-ISP, §3.2.5; Sentinel-1 L1 Detailed Algorithm Definitio
   ``window_start = rank * PRI + SWST + dt_suppr`` (dt_suppr = 320 / (8 f_ref), the suppressed filter
   transient);
 - the packet time (GPS) is the receive time ``rx = tx + SWST + rank * PRI``, so the transmit time of
-  a line is ``tx = rx - SWST - rank * PRI`` (stored as ``azimuth_time``, UTC after ``epoch_utc``);
+  a line is ``tx = rx - SWST - rank * PRI`` (stored as ``azimuth_time``, UTC after ``epoch_utc``), with
+  ``rx`` on the PRI grid of the packets' PRI counter, its offset fitted to the datations (quantized to
+  2^-16 s); the packet times themselves stay in ``auxiliary["s1/echo_time_gps"]``;
 - the replica is the nominal transmitted chirp, exp(j (2 pi f0 t + pi K t^2)), t = k / f_dec,
   k = 0 .. ceil(TXPL f_dec) - 1 (f0: Tx pulse start frequency, K: ramp rate);
 - the carrier is not in the packets: Sentinel-1's 5.405 GHz is used.
@@ -132,9 +134,18 @@ def _segments(h: np.ndarray) -> list[np.ndarray]:
 
 
 def replica(ramp_rate: float, start_frequency: float, pulse_length: float, fs: float) -> np.ndarray:
-    """Nominal Tx chirp at the sampling rate: exp(j (2 pi f0 t + pi K t^2)), ceil(T fs) samples [S1-ISP, §3.2.5.8]."""
-    t = np.arange(int(np.ceil(pulse_length * fs - 1e-9))) / fs
-    return np.exp(1j * (2 * np.pi * start_frequency * t + np.pi * ramp_rate * t * t)).astype(np.complex64)
+    """Nominal Tx chirp at the sampling rate, in sarcli's replica convention (centred: the pulse centre is
+    at sample (n - 1)/2 of n = round(T fs) samples, as the focuser and the simulator assume).
+
+    The packets give the chirp from its start, f(t') = f0 + K t' for 0 <= t' <= T [S1-ISP, §3.2.5.8]; with
+    t = t' - T/2 it is exp(j (2 pi f_c t + pi K t^2)) up to a constant phase, f_c = f0 + K T/2 the centre
+    frequency (0 for a chirp symmetric about the carrier). A replica built from t' = 0 on ceil(T fs)
+    samples would put the pulse centre up to a sample off the one the focuser takes: 1.5 m of range
+    (0.68 sample) on a 66.7 MHz S3 product."""
+    n = int(round(pulse_length * fs))
+    t = (np.arange(n) - 0.5 * (n - 1)) / fs
+    f_c = start_frequency + 0.5 * ramp_rate * pulse_length
+    return np.exp(1j * (2 * np.pi * f_c * t + np.pi * ramp_rate * t * t)).astype(np.complex64)
 
 
 def _bursts(time: np.ndarray, pri: float) -> tuple[np.ndarray, np.ndarray]:
@@ -142,6 +153,27 @@ def _bursts(time: np.ndarray, pri: float) -> tuple[np.ndarray, np.ndarray]:
     gaps = np.flatnonzero(np.diff(time) > 1.5 * pri) + 1
     first = np.r_[0, gaps]
     return first, np.diff(np.r_[first, time.size])
+
+
+#: resolution of the packet datation: fine time in units of 2^-16 s [S1-ISP, §3.2.1.1]
+FINE_TIME_STEP_S = 2.0 ** -16
+
+
+def _pri_grid(t_rx: np.ndarray, pri_count: np.ndarray, pri: float, where: str) -> np.ndarray:
+    """Receive times of the lines on the PRI grid: t0 + (count - count_0) PRI, t0 fitted (least squares)
+    to the packet datations. The datation is quantized to 2^-16 s = 15.3 us, 2.6 % of a 588 us PRI, so
+    the packet times alone jitter the line spacing by up to a fine step (a 1.2 % error of the median
+    spacing on a 1700 Hz PRF); the PRI counter and the PRI code are exact. The fitted offset averages
+    the quantization over the lines (error ~ 15.3 us / sqrt(12 n)). A residual above two fine steps means
+    the counter and the datation disagree (a clock reset, a PRI change inside the segment): refused."""
+    k = (np.asarray(pri_count, np.int64) - int(pri_count[0])).astype(np.float64) * pri
+    t0 = float(np.mean(t_rx - k))
+    grid = t0 + k
+    resid = float(np.max(np.abs(t_rx - grid))) if t_rx.size else 0.0
+    if resid > 2 * FINE_TIME_STEP_S:
+        raise FormatError(f"{where}: packet times depart from the PRI counter by {resid * 1e6:.3g} us (more than two "
+                          "datation steps): the segment's timing is inconsistent")
+    return grid
 
 
 def _product(data, h, rows, noise, cal, orbit_rec, swath, where) -> RawProduct:
@@ -152,8 +184,13 @@ def _product(data, h, rows, noise, cal, orbit_rec, swath, where) -> RawProduct:
     pri = float(p["pri_s"][0])
     rank, swst = int(r0["rank"]), float(p["swst_s"][0])
     t_rx = physical(hs)["time_gps_s"]
-    t_tx = t_rx - swst - rank * pri
-    epoch_gps = np.floor(t_tx[0] * 1e6) / 1e6
+    # times after the first line's whole GPS second, exact in float64 (absolute GPS seconds ~1.3e9 carry
+    # only 2.4e-7 s: an ulp of jitter per line spacing)
+    c0 = int(hs["coarse_time"][0])
+    t_rel = (hs["coarse_time"].astype(np.int64) - c0) + (hs["fine_time"].astype(np.float64) + 0.5) / 65536.0
+    t_tx_rel = _pri_grid(t_rel, hs["pri_count"], pri, where) - swst - rank * pri
+    e_rel = np.floor(t_tx_rel[0] * 1e6) / 1e6
+    epoch_gps = c0 + e_rel
     epoch_utc = anc.gps_to_utc_string(epoch_gps)
     window_start = rank * pri + swst + DELTA_T_SUPPR_S
     k, f0, tp = (float(p[n][0]) for n in ("tx_ramp_rate_hz_per_s", "tx_start_frequency_hz", "tx_pulse_length_s"))
@@ -190,7 +227,7 @@ def _product(data, h, rows, noise, cal, orbit_rec, swath, where) -> RawProduct:
         aux["s1/attitude_angular_rate"] = orbit_rec.angular_rate
         aux["s1/attitude_pointing_status"] = orbit_rec.pointing_status
     return RawProduct(
-        echo=_decode(data, hs, where), azimuth_time=t_tx - epoch_gps, epoch_utc=epoch_utc, radar=radar,
+        echo=_decode(data, hs, where), azimuth_time=t_tx_rel - e_rel, epoch_utc=epoch_utc, radar=radar,
         look_side="right", source="sentinel1-l0", agc_db=(0.5 * hs["rx_gain"]).astype(np.float32),
         replica=replica(k, f0, tp, fs), orbit=orbit, extra_attrs=extra, auxiliary=aux)
 
