@@ -300,13 +300,14 @@ def _products(config: Config, terrain, how: str) -> dict[str, str]:
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 
-        write_slant_geotiff(config.geotiff_slant, full, config.looks_az, config.looks_rg, tags, terrain)
+        write_slant_geotiff(config.geotiff_slant, full, config.looks_az, config.looks_rg, tags, terrain,
+                            inputs=(config.output,))
         products["geotiff_slant"] = str(config.geotiff_slant)
     if config.geotiff:
         from sarcli.focus.geocode import write_map_geotiff
 
         used = write_map_geotiff(config.geotiff, full, config.looks_az, config.looks_rg, config.crs,
-                                 config.pixel_spacing_m, tags, terrain)
+                                 config.pixel_spacing_m, tags, terrain, inputs=(config.output,))
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
     if config.quicklook:

@@ -144,10 +144,12 @@ def _attrs(obj) -> dict[str, Any]:
 def _datasets(f) -> list[dict[str, Any]]:
     import h5py
 
+    from sarcli.io.h5common import is_pure_dimension
+
     found: list[dict[str, Any]] = []
 
     def visit(name, obj):
-        if isinstance(obj, h5py.Dataset):
+        if isinstance(obj, h5py.Dataset) and not is_pure_dimension(obj):
             units = obj.attrs.get("units", None)
             if isinstance(units, bytes):
                 units = units.decode(errors="replace")
@@ -281,7 +283,8 @@ def summarize(path: Path) -> dict[str, Any]:
         }
         summary["time_spans"] = {
             d["path"]: _time_span(f, d["path"], summary["epoch_utc"]) for d in datasets
-            if d["units"] == "s" and len(d["shape"]) == 1 and "time" in d["path"].rsplit("/", 1)[-1]}
+            if (d["units"] == "s" or str(d["units"]).startswith("seconds since")) and len(d["shape"]) == 1
+            and "time" in d["path"].rsplit("/", 1)[-1]}
         if prov["product_type"] == "raw" and "echo" in f:
             summary["main_dataset"] = "/echo"
             _raw_summary(f, summary)

@@ -189,9 +189,11 @@ def interfere_cmd(
     window: int = typer.Option(5, "--window", help="Coherence boxcar window (pixels)."),
     ground_height: float = typer.Option(0.0, "--ground-height", help="Reference surface height z (m) of the model."),
     geotiff: Path = typer.Option(None, "--geotiff", help="UTM GeoTIFF of the residual phase (rad)."),
-    png: Path = typer.Option(None, "--png", help="PNG of the residual phase (cyclic colour map)."),
-    value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m)."),
+    png: Path = typer.Option(None, "--png", help="PNG of the residual phase: hue = phase, brightness = coherence."),
+    value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m), unwrapped."),
     value_geotiff: Path = typer.Option(None, "--value-geotiff", help="UTM GeoTIFF of the converted value."),
+    coherence_png: Path = typer.Option(None, "--coherence-png", help="PNG of the coherence (0..1)."),
+    coherence_geotiff: Path = typer.Option(None, "--coherence-geotiff", help="UTM GeoTIFF of the coherence."),
     min_coherence: float = typer.Option(0.5, "--min-coherence", help="The converted value (product, --value-png, "
                                         "--value-geotiff) is NaN where the coherence is below this (0 keeps all)."),
     map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
@@ -199,7 +201,8 @@ def interfere_cmd(
 ) -> None:
     """Interferogram of two GB-SAR images: phase, coherence, model phase removed, converted value.
 
-    dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m).
+    dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m),
+    from the residual phase unwrapped spatially (SNAPHU, coherence-weighted; docs/gbsar.md).
     Scans given instead of images are focused with --algorithm auto first. Pixels outside the beam
     footprint (no image support) are NaN (blank in PNGs, nodata in GeoTIFFs); the converted value is
     also NaN where the coherence is below --min-coherence.
@@ -209,12 +212,15 @@ def interfere_cmd(
       sarcli gbsar interfere t2.h5 t3.h5 --mode crosstrack -o xt.h5 --png xt.png --value-png height.png
 
       sarcli gbsar interfere t1.h5 t2.h5 --mode dinsar -o dinsar.h5 --value-geotiff los.tif --json
+
+      sarcli gbsar interfere t1.h5 t2.h5 -o dinsar.h5 --png phase.png --coherence-png coherence.png
     """
     from sarcli.workflows import gbsar_interfere as wf
 
     cfg = wf.Config(reference=reference, secondary=secondary, output=output, mode=mode, pol=pol, window=window,
                     ground_height_m=ground_height, min_coherence=min_coherence, geotiff=geotiff, png=png,
-                    value_png=value_png, value_geotiff=value_geotiff, map_pixel_m=map_pixel)
+                    value_png=value_png, value_geotiff=value_geotiff, coherence_png=coherence_png,
+                    coherence_geotiff=coherence_geotiff, map_pixel_m=map_pixel)
     run_workflow(wf, cfg, json_out)
 
 
