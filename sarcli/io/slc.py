@@ -145,7 +145,6 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
     if s.truth is not None:
         write_mapping(f, "truth", s.truth, s.epoch_utc)
     tg = group(f, "timings")
-    tg.attrs["description"] = "wall time of each processing stage (s)"
     for k, v in sorted(s.timings.items()):
         tg.attrs[k] = float(v)
 
