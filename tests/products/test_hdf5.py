@@ -54,7 +54,8 @@ def test_raw_is_self_describing_and_time_aware(tmp_path):
     want = _epoch64(p.epoch_utc) + (p.azimuth_time * 1e9).round().astype("timedelta64[ns]")
     assert np.abs(root.azimuth_time.values - want).max() <= np.timedelta64(1, "ns")
     c, r = 299792458.0, p.radar
-    np.testing.assert_allclose(root.slant_range.values, c / 2 * (r.window_start_s + np.arange(24) / r.range_sampling_rate_hz))
+    tau = r.window_start_s + np.arange(24) / r.range_sampling_rate_hz  # two-way delay of each sample
+    np.testing.assert_allclose(root.slant_range.values, c / 2 * tau)
     assert groups["/orbit"].position.dims == ("time", "xyz") and groups["/attitude"].pitch.dims == ("time",)
     assert groups["/radar"].agc_db.dims == ("azimuth_time",)
     assert groups["/truth"].doppler_centroid_hz.attrs["units"] == "Hz"
