@@ -33,7 +33,8 @@ def _options(values: list[str]) -> dict[str, object]:
 def export(
     source: Path = typer.Argument(..., help="Focused image: a sarcli SLC product or a NISAR RSLC file."),
     output: Path = typer.Option(..., "-o", "--output", help="File to write."),
-    fmt: str = typer.Option("nisar-rslc", "--format", help="Output format (built in: nisar-rslc, sicd, envi)."),
+    fmt: str = typer.Option("nisar-rslc", "--format", metavar="[nisar-rslc|sicd|envi|PLUG-IN]",
+                            help="Output format (built in: nisar-rslc, sicd, envi)."),
     polarization: str = typer.Option(None, "--polarization",
                                      help="Layer name: for a sarcli SLC the polarization it is (default HH); for "
                                           "an RSLC input the layer to read (default HH, else the first)."),

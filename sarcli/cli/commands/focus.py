@@ -35,7 +35,8 @@ def focus(
     channel: int = typer.Option(0, "--channel", help="Receive channel to focus (0 = /echo)."),
     height: float = typer.Option(0.0, "--height", help="Terrain height above the WGS-84 ellipsoid, m (default 0)."),
     dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),
-    dem_geoid: str = typer.Option(None, "--dem-geoid", help="The DEM's heights are above this geoid: egm96 | "
+    dem_geoid: str = typer.Option(None, "--dem-geoid", metavar="[egm96|egm2008]",
+                                  help="The DEM's heights are above this geoid: egm96 | "
                                   "egm2008 (default: above the ellipsoid)."),
     range_window: str = typer.Option(None, "--range-window", help="rect | hamming[:a] | kaiser[:beta] "
                                      "(default kaiser:2.5)."),

@@ -61,7 +61,8 @@ def import_cmd(
                                  "[default: position, pos, ..., or x,y,z]."),
     reference_range: str = typer.Option(None, "--reference-range", help="Range (m) each sweep's phase is referenced "
                                         "to, per sweep or one value [default: r0, R0, reference_range if present]."),
-    layout: str = typer.Option("auto", "--layout", help="auto | frequency-position | position-frequency (needed when "
+    layout: str = typer.Option("auto", "--layout", metavar="[auto|frequency-position|position-frequency]",
+                               help="auto | frequency-position | position-frequency (needed when "
                                "the matrix is square)."),
     pol: str = typer.Option(None, "--pol", help="Polarization VV|VH|HV|HH [default: from the file names, else VV]."),
     height: float = typer.Option(0.0, "--height", help="Antenna height (m) of 1-D rail positions."),
@@ -120,7 +121,7 @@ def plan_cmd(
 def focus_cmd(
     scan: Path = typer.Argument(..., help="Scan product (.h5)."),
     output: Path = typer.Option(..., "-o", "--output", help="Output image product (.h5)."),
-    algorithm: str = typer.Option("auto", "--algorithm", help="auto | df | rd | bp."),
+    algorithm: str = typer.Option("auto", "--algorithm", metavar="[auto|df|rd|bp]", help="auto | df | rd | bp."),
     pol: list[str] = typer.Option(None, "--pol", help="Polarization(s) to focus [default: all]."),
     max_range: float = typer.Option(None, "--max-range", help="Largest image range R0 (m) [default: R_max]."),
     min_range: float = typer.Option(0.0, "--min-range", help="Smallest image range R0 (m)."),
@@ -129,9 +130,10 @@ def focus_cmd(
     width: float = typer.Option(None, "--width", help="Azimuth width of the image (m) [default: beam "
                                 "footprint at the top range plus the rail, at most DF's width]."),
     criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg) for auto."),
-    near: str = typer.Option("bp", "--near", help="auto's near-range algorithm: bp | rd."),
+    near: str = typer.Option("bp", "--near", metavar="[bp|rd]", help="auto's near-range algorithm: bp | rd."),
     n_xfft: int = typer.Option(None, "--n-xfft", help="Azimuth FFT size for DF/RD [default: the paper's rule]."),
-    rd_reference: str = typer.Option("sinc", "--rd-reference", help="RD reference weighting: sinc (real "
+    rd_reference: str = typer.Option("sinc", "--rd-reference", metavar="[sinc|rect]",
+                                     help="RD reference weighting: sinc (real "
                                      "antenna) | rect (the paper's ideal beam)."),
     range_window: str = typer.Option("hamming", "--range-window", help=f"Taper over the frequencies: {_WINDOW_HELP}."),
     azimuth_window: str = typer.Option("hamming", "--azimuth-window",
@@ -184,7 +186,8 @@ def interfere_cmd(
     reference: Path = typer.Argument(..., help="Reference image (or scan) A."),
     secondary: Path = typer.Argument(..., help="Secondary image (or scan) B; the interferogram is B * conj(A)."),
     output: Path = typer.Option(..., "-o", "--output", help="Output interferogram product (.h5)."),
-    mode: str = typer.Option("dinsar", "--mode", help="dinsar | crosstrack | deltaf | combined."),
+    mode: str = typer.Option("dinsar", "--mode", metavar="[dinsar|crosstrack|deltaf|combined]",
+                             help="dinsar | crosstrack | deltaf | combined."),
     pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of A]."),
     window: int = typer.Option(5, "--window", help="Coherence boxcar window (pixels)."),
     ground_height: float = typer.Option(0.0, "--ground-height", help="Reference surface height z (m) of the model."),
