@@ -219,6 +219,7 @@ def measure_targets(slc, positions: list[tuple[float, float]], truth_known: bool
         e_rg = (m["col"] - col) * dr
         rec = {
             "range_m": float(r[0] + m["col"] * dr), "azimuth_time_s": float(t[0] + m["row"] * dt),
+            "row": float(m["row"]), "col": float(m["col"]),
             "irw_range_m": m["irw_range_px"] * dr, "irw_azimuth_m": m["irw_azimuth_px"] * ds_az,
             "pslr_range_db": m["pslr_range_db"], "pslr_azimuth_db": m["pslr_azimuth_db"],
             "islr_range_db": m["islr_range_db"], "islr_azimuth_db": m["islr_azimuth_db"],
