@@ -76,7 +76,7 @@ def quality(
                 report(line)
         return
     if plots is not None:
-        raise ConfigError("--plots goes with --corner-reflectors (point targets: --plot PNG)")
+        raise ConfigError("--plots goes with --corner-reflectors")
     from sarcli.workflows.quality import Config, run
 
     rep = run(Config(slc=slc_path, at=_parse_at(at or []), frequency=frequency, polarization=polarization,
