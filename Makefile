@@ -6,17 +6,56 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 DEMO   := demo
-export NUMBA_CACHE_DIR ?= $(CURDIR)/.numba_cache
+# The tested set: exact versions of every package in .venv (make lock); make install applies it.
+LOCK   := requirements/constraints.txt
+LOCK_VENV ?= $(VENV)
+LATEST := .venv-latest
+WARM   := $(VENV)/warm-up
 
-.PHONY: install demo test test-fast bench lint clean
+.PHONY: install warm-cache demo test test-latest lock bench lint clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[dev]'
+	$(BIN)/python -m pip install -q -c $(LOCK) --upgrade pip
+	$(BIN)/python -m pip install -q -c $(LOCK) -e '.[dev]'
+	@$(MAKE) --no-print-directory warm-cache
 	@touch $@
 
 install: $(STAMP)
+
+## lock: write the exact versions installed in $(LOCK_VENV) to $(LOCK) (see docs/dependencies.md);
+##   after a green `make test-latest`: make lock LOCK_VENV=.venv-latest && make install
+lock:
+	@test -x $(LOCK_VENV)/bin/python || { echo "make lock: no environment $(LOCK_VENV) (run make install)" >&2; exit 2; }
+	@mkdir -p $(dir $(LOCK))
+	@{ echo "# The tested set: every package of $(LOCK_VENV), exact versions; written by 'make lock', applied by"; \
+	   echo "# 'make install' (pip install -c). Python $$($(LOCK_VENV)/bin/python -c 'import platform; print(platform.python_version(), platform.system(), platform.machine())')."; \
+	   echo "# Do not edit by hand: see docs/dependencies.md."; \
+	   $(LOCK_VENV)/bin/python -m pip freeze --all --exclude-editable | grep -viE '^(sarcli|setuptools|wheel)=='; \
+	 } > $(LOCK).tmp && mv $(LOCK).tmp $(LOCK)
+	@echo "make lock: $$(grep -vc '^#' $(LOCK)) packages from $(LOCK_VENV) written to $(LOCK)"
+
+## test-latest: a fresh $(LATEST) with the newest releases (no constraints), the whole suite in it,
+##   and a report of what is newer than the lock and which tests broke (docs/dependencies.md)
+test-latest:
+	rm -rf $(LATEST)
+	$(PYTHON) -m venv $(LATEST)
+	$(LATEST)/bin/python -m pip install -q --upgrade pip
+	$(LATEST)/bin/python -m pip install -q --upgrade -e '.[dev]'
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache-latest $(LATEST)/bin/python .ci/test_latest.py --lock $(LOCK) \
+	  -- -q -n 2 --dist loadfile
+
+## warm-cache: compile the numba kernels of the main commands into the per-user cache (sarcli/__init__.py)
+##   on small samples, so that the first command after install loads them instead of compiling (run by install)
+warm-cache:
+	@rm -rf $(WARM) && mkdir -p $(WARM)
+	$(BIN)/sarcli -q simulate samples/rs1_point.toml -o $(WARM)/raw.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
+	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5
+	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
+	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
+	@rm -rf $(WARM)
 
 ## demo: the main job on the embedded default sample (see README "Demo")
 demo: $(STAMP)
@@ -80,4 +119,5 @@ $(OUT)/%.slc.h5 $(OUT)/%.tif $(OUT)/%.png: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5
 .PRECIOUS: $(OUT)/%.raw.h5 $(OUT)/%.doppler.h5 $(OUT)/%.slc.h5
 
 clean:
-	rm -rf $(DEMO) .pytest_cache .hypothesis .numba_cache
+	rm -rf $(DEMO) .pytest_cache .hypothesis .numba_cache .numba_cache-latest $(LATEST)
+	rm -rf $(DEMO) .pytest_cache .hypothesis

@@ -11,6 +11,11 @@ call (scipy.fft scratch is not counted), next to Table 1's ``N_Rfft x N_xfft x 8
 Goals (issue 6): outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
 everywhere at no more than twice DF's time plus the near-range part.
 
+RD core vs a naive numpy RD (issue 19): ``focus_rd`` (complex64 numba kernels) against
+``focus_rd_reference`` (the plain-numpy implementation it replaced: complex128 reference per block,
+``nanmedian`` per column) on both polarizations of samples/gbsar_outdoor.toml, 600 m image, in
+interleaved rounds (best of each), with the normwise difference of the images.
+
 PS coherence (issue 15): ``sarcli gbsar coherence`` on N image products of the outdoor grid, read by
 blocks of rows from their HDF5 files, against the former whole-stack computation (every image read,
 ``np.stack``): wall time and tracemalloc peak of each.
@@ -21,6 +26,7 @@ from __future__ import annotations
 import os
 import time
 import tracemalloc
+from pathlib import Path
 
 import numpy as np
 
@@ -28,8 +34,8 @@ from bench.common import best_time, first_call_time, markdown_table, write_resul
 from sarcli.gbsar.deramp import focus_df, geometric_correction
 from sarcli.gbsar.focus import FocusOptions, default_grid, focus_scan
 from sarcli.gbsar.rangecomp import range_compress
-from sarcli.gbsar.rangedoppler import focus_rd
-from sarcli.gbsar.scene import scene_from_dict
+from sarcli.gbsar.rangedoppler import focus_rd, focus_rd_reference
+from sarcli.gbsar.scene import load_scene, scene_from_dict
 from sarcli.gbsar.simulate import simulate
 from sarcli.gbsar.system import azimuth_resolution, build_system
 
@@ -199,12 +205,48 @@ def _bench_coherence(n_images: int = 24, shape: tuple[int, int] = (1025, 469)) -
     return out, row
 
 
+SAMPLES = Path(__file__).resolve().parents[1] / "samples"
+
+
+def _bench_rd_core(rounds: int = 2) -> tuple[dict, list]:
+    """RD of both polarizations of the outdoor sample (600 m), numba vs the naive numpy RD, interleaved."""
+    scan = simulate(load_scene(SAMPLES / "gbsar_outdoor.toml"))
+    profs = [range_compress(scan, pol, "hamming", 2, max_range_m=600.0 * 1.05 + 1.0) for pol in scan.polarizations]
+    kw = dict(antenna_length_m=scan.antenna.length_azimuth_m, max_range_m=600.0)
+    t_fast = t_ref = np.inf
+    first = first_call_time(lambda: [focus_rd(p, **kw) for p in profs])
+    for _ in range(rounds):
+        t_ref = min(t_ref, best_time(lambda: [focus_rd_reference(p, **kw) for p in profs], repeat=1, warmup=0))
+        t_fast = min(t_fast, best_time(lambda: [focus_rd(p, **kw) for p in profs], repeat=1, warmup=0))
+    err = []
+    for p in profs:
+        a, b = focus_rd(p, **kw).data, focus_rd_reference(p, **kw).data
+        err.append(float(np.linalg.norm(a - b) / np.linalg.norm(b)))
+    t_scan = best_time(lambda: focus_scan(scan, FocusOptions(algorithm="rd", max_range_m=600.0)), repeat=1)
+    shape = focus_rd(profs[0], **kw).data.shape
+    data = {"polarizations": list(scan.polarizations), "image_shape": list(shape), "rounds": rounds,
+            "numba_s": t_fast, "numpy_reference_s": t_ref, "speed_up": t_ref / t_fast, "first_call_s": first,
+            "normwise_difference": err, "focus_scan_rd_s": t_scan}
+    row = [f"{len(profs)} x {shape[0]} x {shape[1]}", t_ref, t_fast, t_ref / t_fast, max(err), first, t_scan]
+    return data, row
+
+
 def main() -> None:
     rows, core_rows, data = [], [], {"configs": {}}
+    data["rd_core"], rd_row = _bench_rd_core()
     for name, cfg in CONFIGS.items():
         data["configs"][name] = _bench_config(name, cfg, rows, core_rows)
     data["coherence"], coh_row = _bench_coherence()
-    md = ["# GB-SAR focusing benchmark (DF / RD / BP / auto)\n",
+    outdoor = data["configs"]["outdoor"]["algorithms"]
+    rd = data["rd_core"]
+    summary = markdown_table(["what", "figure"], [
+        ["RD core, 2 polarizations of the outdoor scan (600 m), numba vs naive numpy RD",
+         f"{rd['speed_up']:.1f}x faster ({rd['numba_s']:.2f} vs {rd['numpy_reference_s']:.2f} s), images "
+         f"within {max(rd['normwise_difference']):.1e}"],
+        ["outdoor 1601 x 101: DF core / BP of the 600 m image / auto",
+         f"{outdoor['df']['seconds'] * 1e3:.0f} ms / {outdoor['bp']['seconds']:.2f} s / "
+         f"{outdoor['auto']['seconds'] * 1e3:.0f} ms"]])
+    md = ["# GB-SAR focusing benchmark (DF / RD / BP / auto)\n", summary,
           f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, 2 shared cores, load average "
           f"{os.getloadavg()[0]:.1f} at the end. Targets with the sinc "
           "antenna pattern; errors against truth (position) and against BP (amplitude, phase) at each target; "
@@ -215,6 +257,14 @@ def main() -> None:
           markdown_table(["config", "algorithm", "ms (best of 3)", "first call s", "numpy peak MB",
                           "near pos err m", "near |amp vs BP| dB", "far II pos err m",
                           "far II |amp vs BP| dB", "far II |phase vs BP| deg", "worst PSLR dB"], rows),
+          "\n## RD core vs a naive numpy RD (samples/gbsar_outdoor.toml, both polarizations, 600 m)\n",
+          "`focus_rd` (complex64 numba kernels, FFTs along contiguous rows on all cores) against "
+          "`focus_rd_reference` (plain numpy: complex128 reference chirp per block, `nanmedian` per column), "
+          "same range-compressed profiles, interleaved rounds, best of each; difference = "
+          "||numba - numpy|| / ||numpy|| over the image (float32 rounding; tests/gbsar/test_rd_kernel.py). "
+          "`focus_scan` = the whole `--algorithm rd` focus of both polarizations onto the default grid.\n",
+          markdown_table(["images", "numpy RD s", "numba RD s", "speed-up", "normwise difference",
+                          "first call s", "focus_scan rd s"], [rd_row]),
           "\n## Paper cores at Table 1 sizes\n",
           "DF keeps the positive-range half of the N_Rfft bins (the paper's image is that half too), so its "
           "array is half of Table 1's; RD runs on 2x oversampled range bins, so its output array is Table 1's.\n",

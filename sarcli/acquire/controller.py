@@ -142,12 +142,15 @@ class ScanResult:
 
 def run_scan(cfg: ScanConfig, inst: Instruments, writer: ScanWriter, epoch_utc: str,
              on_stop: Callable[[int], None] | None = None,
-             stop_requested: Callable[[], bool] | None = None) -> ScanResult:
-    """Measure stops ``writer.n_complete .. count-1``; returns how it ended (never raises on faults)."""
+             stop_requested: Callable[[], bool] | None = None,
+             clock: Callable[[], float] | None = None) -> ScanResult:
+    """Measure stops ``writer.n_complete .. count-1``; returns how it ended (never raises on faults).
+    ``clock``: POSIX seconds stamping each stop (default ``time.time``; a simulated campaign clock)."""
     r, pols = cfg.rail, cfg.polarization.polarizations
     positions = r.positions()
     t_epoch = _epoch_seconds(epoch_utc)
     stop = stop_requested or (lambda: False)
+    clock = clock or time.time
     t0 = time.perf_counter()
     res = ScanResult(writer.n_complete, r.count, "interrupted", 0.0)
     data = np.empty((len(pols), cfg.vna.points), np.complex64)
@@ -159,7 +162,7 @@ def run_scan(cfg: ScanConfig, inst: Instruments, writer: ScanWriter, epoch_utc: 
             st = inst.rail.move_to(r.machine_mm(positions[k]), r.feed_mm_min)
             t_move = time.perf_counter() - ts
             _sleep(r.settle_s, stop)
-            stamp = time.time() - t_epoch
+            stamp = clock() - t_epoch
             t_sweep = 0.0
             for i, pol in enumerate(pols):
                 inst.switch.select(pol)

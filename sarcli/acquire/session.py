@@ -60,16 +60,19 @@ def plan_summary(cfg: ScanConfig, remaining: int | None = None) -> dict[str, Any
 
 
 def acquire(cfg: ScanConfig, vna_port: str, rail_port: str, output: str | os.PathLike, resume: bool,
-            stop: Callable[[], bool], on_stop: Callable[[int, int], None] | None = None) -> dict[str, Any]:
+            stop: Callable[[], bool], on_stop: Callable[[int, int], None] | None = None,
+            epoch_utc: str | None = None, clock: Callable[[], float] | None = None) -> dict[str, Any]:
     """Run (or resume) one scan into ``output``; returns a summary. Faults after the file exists
-    raise SarcliError *after* the file has been closed with every completed stop in it."""
+    raise SarcliError *after* the file has been closed with every completed stop in it.
+    ``epoch_utc`` (a new scan's epoch, default now) and ``clock`` (POSIX seconds for the stop times,
+    default ``time.time``) let a simulated campaign clock (``gbsar monitor --time-scale``) stamp the scan."""
     output = str(output)
     if resume:
         n_done, epoch = check_resume(output, cfg)
     else:
         if Path(output).exists():
             raise ConfigError(f"{output} exists; continue it with --resume {output} or choose another name")
-        n_done, epoch = 0, utc_now()
+        n_done, epoch = 0, epoch_utc or utc_now()
     inst = connect(cfg, vna_port, rail_port, stop_requested=stop)
     try:
         if resume:
@@ -84,7 +87,7 @@ def acquire(cfg: ScanConfig, vna_port: str, rail_port: str, output: str | os.Pat
             on_stop(writer.n_complete, cfg.rail.count)
         res = run_scan(cfg, inst, writer, epoch,
                        on_stop=None if on_stop is None else (lambda n: on_stop(n, cfg.rail.count)),
-                       stop_requested=stop)
+                       stop_requested=stop, clock=clock)
     finally:
         inst.close()
     summary = {"output": output, "status": res.status, "n_complete": res.n_complete,

@@ -102,7 +102,8 @@ def make_typer(**kwargs: Any) -> typer.Typer:
     kwargs.setdefault("add_completion", False)
     kwargs.setdefault("pretty_exceptions_enable", False)
     kwargs.setdefault("rich_markup_mode", None)
-    return typer.Typer(cls=SarcliGroup, **kwargs)
+    kwargs.setdefault("cls", SarcliGroup)
+    return typer.Typer(**kwargs)
 
 
 def emit_json(obj: Any) -> None:

@@ -18,7 +18,8 @@ import typer
 from sarcli.cli.common import emit_json, info, make_typer, progress_bar
 
 gbsar_app = make_typer(
-    help="Ground-based SAR: simulate, plan, focus, interfere, coherence; acquire with a VNA and a rail.",
+    help="Ground-based SAR: simulate, import, plan, focus, interfere, coherence; acquire with a VNA and a rail; "
+         "monitor a slope.",
 )
 
 _ATTACHED: set[int] = set()

@@ -128,28 +128,60 @@ def _sgn(x):
     return np.float32((x > 0) - (x < 0))
 
 
+#: pair lines per task of the kernel: an azimuth block is cut into tasks of this many lines so that
+#: every thread gets an equal share (11 blocks of 2048 lines on 2 threads would leave one idle 1/12
+#: of the time); the partial sums of a block's tasks are added in task order (deterministic)
+CHUNK_LINES = 256
+
+
+@njit(cache=True, inline="always")
+def _line_energy(v, k0, n):
+    e = np.float32(0.0)
+    w = v[2 * k0:2 * (k0 + n)]
+    for k in range(2 * n):
+        e += w[k] * w[k]
+    return e
+
+
+@njit(cache=True, inline="always")
+def _line_energy_sign(v, k0, n):
+    e = np.float32(0.0)
+    w = v[2 * k0:2 * (k0 + n)]
+    for k in range(2 * n):
+        e += _sgn(w[k]) * _sgn(w[k])
+    return e
+
+
 @njit(cache=True, parallel=True, fastmath=True)
-def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im, energy, pairs):
+def _lag_kernel(x, task_m0, task_m1, samp0, nsamp, sign_mode, lag, part):
     # x is the echo viewed as float32 (n_lines, 2 n_samples): interleaved re, im (SIMD-friendly).
-    # Azimuth blocks in parallel; inside a block the lines are streamed in memory order (line m and
-    # m+1 whole, line m+1 is still in cache for the next pair) with one accumulator per range block.
-    # One line of one range block (<= a few hundred products) is summed in float32 (fastmath lets
-    # the reduction vectorize), every line's partial sum is added in float64.
-    nab = line0.shape[0]
+    # Tasks (runs of pair lines [m0, m1) inside one azimuth block) in parallel; inside a task the lines
+    # are streamed in memory order (line m and m+lag whole, the later one still in cache when its turn
+    # comes) with one accumulator per range block. One line of one range block (<= a few hundred
+    # products) is summed in float32 (fastmath lets the reduction vectorize), every line's partial sum
+    # is added in float64. The energy sum_m (|h(m+lag)|^2 + |h(m)|^2)/2 is formed from each line's
+    # energy, computed once: line l counts 1/2 as a "later" line (l in [m0+lag, m1+lag)) and 1/2 as
+    # an "earlier" line (l in [m0, m1)); part[t] = (re C, im C, E) per range block of task t.
     nrb = samp0.shape[0]
-    for ib in prange(nab):
-        m0 = line0[ib]
-        m1 = m0 + nlines[ib] - lag
-        cr = np.zeros(nrb)
-        ci = np.zeros(nrb)
-        en = np.zeros(nrb)
+    for t in prange(task_m0.shape[0]):
+        m0 = task_m0[t]
+        m1 = task_m1[t]
+        for m in range(m0, min(m0 + lag, m1)):  # earlier-only lines of this task
+            for jb in range(nrb):
+                if sign_mode:
+                    part[t, 2, jb] += 0.5 * np.float64(_line_energy_sign(x[m], samp0[jb], nsamp[jb]))
+                else:
+                    part[t, 2, jb] += 0.5 * np.float64(_line_energy(x[m], samp0[jb], nsamp[jb]))
         for m in range(m0, m1):
+            la = x[m + lag]
+            lb = x[m]
+            we = 1.0 if m + lag < m1 else 0.5
             for jb in range(nrb):
                 # slices start at 0, so numba can drop the negative-index wraparound test and the
                 # loops vectorize (2.6x faster than indexing the whole line from k0)
                 n = nsamp[jb]
-                a = x[m + lag, 2 * samp0[jb]:2 * (samp0[jb] + n)]
-                b = x[m, 2 * samp0[jb]:2 * (samp0[jb] + n)]
+                a = la[2 * samp0[jb]:2 * (samp0[jb] + n)]
+                b = lb[2 * samp0[jb]:2 * (samp0[jb] + n)]
                 sr = np.float32(0.0)
                 si = np.float32(0.0)
                 se = np.float32(0.0)
@@ -161,7 +193,7 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                         bi = _sgn(b[2 * k + 1])
                         sr += ar * br + ai * bi
                         si += ai * br - ar * bi
-                        se += ar * ar + ai * ai + br * br + bi * bi
+                        se += ar * ar + ai * ai
                 else:
                     for k in range(n):
                         ar = a[2 * k]
@@ -170,15 +202,23 @@ def _lag_kernel(x, line0, nlines, samp0, nsamp, sign_mode, lag, corr_re, corr_im
                         bi = b[2 * k + 1]
                         sr += ar * br + ai * bi
                         si += ai * br - ar * bi
-                        se += ar * ar + ai * ai + br * br + bi * bi
-                cr[jb] += np.float64(sr)
-                ci[jb] += np.float64(si)
-                en[jb] += 0.5 * np.float64(se)
-        for jb in range(nrb):
-            corr_re[ib, jb] = cr[jb]
-            corr_im[ib, jb] = ci[jb]
-            energy[ib, jb] = en[jb]
-            pairs[ib, jb] = max(m1 - m0, 0) * nsamp[jb]
+                        se += ar * ar + ai * ai
+                part[t, 0, jb] += np.float64(sr)
+                part[t, 1, jb] += np.float64(si)
+                part[t, 2, jb] += we * np.float64(se)
+
+
+def _tasks(line0: np.ndarray, nlines: np.ndarray, lag: int, chunk: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(first pair line, end pair line, first task of each block): each azimuth block's pair lines
+    [l0, l0 + n - lag) cut into runs of ``chunk`` (a block without pairs keeps one empty task)."""
+    m0s, m1s, first = [], [], []
+    for l0, n in zip(line0.tolist(), nlines.tolist(), strict=True):
+        first.append(len(m0s))
+        end = l0 + max(n - lag, 0)
+        starts = list(range(l0, end, chunk)) or [l0]
+        m0s += starts
+        m1s += [min(s + chunk, end) for s in starts]
+    return np.asarray(m0s, np.int64), np.asarray(m1s, np.int64), np.asarray(first, np.int64)
 
 
 def _grid(shape: tuple[int, int], az_block: int, rg_block: int, lag: int = 1):
@@ -211,10 +251,12 @@ def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 12
     if lag < 1:
         raise SarcliError(f"correlation lag must be >= 1, got {lag}")
     l0, nl, s0, ns = _grid(h.shape, az_block, rg_block, lag)
-    shp = (l0.size, s0.size)
-    cr, ci, en = np.zeros(shp), np.zeros(shp), np.zeros(shp)
-    pr = np.zeros(shp, np.int64)
-    _lag_kernel(h.view(np.float32), l0, nl, s0, ns, estimator == "sde", lag, cr, ci, en, pr)
+    m0, m1, first = _tasks(l0, nl, lag, CHUNK_LINES)
+    part = np.zeros((m0.size, 3, s0.size))
+    _lag_kernel(h.view(np.float32), m0, m1, s0, ns, estimator == "sde", lag, part)
+    sums = np.add.reduceat(part, first, axis=0)  # tasks of a block, in order
+    cr, ci, en = sums[:, 0], sums[:, 1], sums[:, 2]
+    pr = np.maximum(nl - lag, 0)[:, None] * ns[None, :]
     if estimator == "sde" or not (np.isfinite(en).all() and np.isfinite(cr).all() and np.isfinite(ci).all()):
         # every sample enters some block energy, so a NaN/inf input shows up there for free (CDE);
         # the sign estimator maps NaN to 0 and needs the explicit pass

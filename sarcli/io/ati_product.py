@@ -22,19 +22,25 @@ import json
 import os
 from typing import Any
 
+import h5py
 import numpy as np
 
+from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     atomic_h5,
-    attr_str,
+    attr_json,
+    attr_number,
+    attr_value,
     cf_time_units,
     coordinate,
     dataset,
     open_product,
-    require,
+    read_array,
     to_jsonable,
     units_from_name,
 )
+from sarcli.model import checks as ck
+from sarcli.model.raw import LOOK_SIDES
 
 PRODUCT_TYPE = "ati"
 SCHEMA_VERSION = "1"
@@ -87,16 +93,33 @@ def write_ati(path: str | os.PathLike, *, epoch_utc: str, t_ref_s: float, look_s
 
 
 def read_ati(path: str | os.PathLike) -> dict[str, Any]:
-    """The product as a dict (arrays loaded); a malformed file raises ProductError (one line)."""
+    """The product as a dict (arrays loaded); a malformed file raises ProductError (one line). Checked:
+    an ISO-8601 epoch, a finite t_ref_s, a look side, JSON detection (object) and movers (list), finite
+    increasing axes, finite complex images and ATI phase on their grid, the movers table with its fields."""
     with open_product(path, PRODUCT_TYPE) as f:
+        where = str(path)
+        t = read_array(f, "azimuth_time", "f", ndim=1, min_size=1)
+        r = read_array(f, "slant_range", "f", ndim=1, min_size=1)
+        ck.increasing(where, "azimuth_time", t)
+        ck.increasing(where, "slant_range", r)
+        grid = (t.size, r.size)
         out: dict[str, Any] = {
-            "epoch_utc": attr_str(f, "epoch_utc"), "t_ref_s": float(f.attrs["t_ref_s"]),
-            "look_side": attr_str(f, "look_side"),
-            "detection": json.loads(attr_str(f, "detection") or "{}"),
-            "movers": json.loads(attr_str(f, "movers_json") or "[]"),
+            "epoch_utc": ck.utc(where, "epoch_utc", attr_value(f, "epoch_utc")),
+            "t_ref_s": attr_number(f, "t_ref_s", unit="s"),
+            "look_side": ck.text(where, "look_side", attr_value(f, "look_side"), LOOK_SIDES),
+            "detection": attr_json(f, "detection", {}, kind=dict),
+            "movers": attr_json(f, "movers_json", [], kind=list),
+            "azimuth_time": t, "slant_range": r,
+            "image_before": read_array(f, "image_before", "c", shape=grid),
+            "ati_phase": read_array(f, "ati_phase", "f", shape=grid),
+            "image_after": read_array(f, "image_after", "c", shape=grid, required=False),
         }
-        for k in ("azimuth_time", "slant_range", "image_before", "ati_phase", "movers_table"):
-            name = "movers" if k == "movers_table" else k
-            out[k] = require(f, name, path)[()]
-        out["image_after"] = f["image_after"][()] if "image_after" in f else None
+        if "movers" not in f or not isinstance(f["movers"], h5py.Dataset):
+            raise ProductError(f"{path}: malformed product, missing 'movers'")
+        tab = f["movers"][()]
+        names = tab.dtype.names or ()
+        missing = [k for k in ("id", *MOVER_FIELDS) if k not in names]
+        if tab.ndim != 1 or missing:
+            raise ProductError(f"{path}: malformed movers table (missing field(s) {', '.join(missing) or '-'})")
+        out["movers_table"] = tab
         return out

@@ -31,7 +31,19 @@ from collections.abc import Iterator
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, coordinate, dataset, group, open_product, require
+from sarcli.io.h5common import (
+    atomic_h5,
+    attr_json,
+    attr_number,
+    attr_str,
+    coordinate,
+    dataset,
+    group,
+    open_product,
+    read_array,
+    require,
+)
+from sarcli.io.scan import read_attr_group
 from sarcli.model.gbsar import GbsarImage, Site
 
 PRODUCT_TYPE = "gbsar_image"
@@ -77,7 +89,8 @@ def write_gbsar_image(path: str | os.PathLike, img: GbsarImage, parameters: dict
 @contextlib.contextmanager
 def open_gbsar_image(path: str | os.PathLike) -> Iterator[GbsarImage]:
     """The image product with its pixels left on disk: ``image`` is the HDF5 dataset (n_pol, n_range,
-    n_azimuth), read by slicing (e.g. a block of rows), valid inside the ``with`` block only."""
+    n_azimuth), read by slicing (e.g. a block of rows), valid inside the ``with`` block only. Everything
+    but the pixels is validated (:meth:`GbsarImage.validate`)."""
     with open_product(path, PRODUCT_TYPE) as f:
         version = attr_str(f, "schema_version")
         if version not in (SCHEMA_VERSION, SCHEMA_VERSION_GRID):
@@ -85,24 +98,24 @@ def open_gbsar_image(path: str | os.PathLike) -> Iterator[GbsarImage]:
         missing = [k for k in _SCALARS if k not in f.attrs]
         if missing:
             raise ProductError(f"{path}: malformed gbsar_image, missing attribute(s) {', '.join(missing)}")
-        vals = {k: (attr_str(f, k) if k in ("algorithm", "epoch_utc") else f.attrs[k].item()) for k in _SCALARS}
-        site = Site(**{k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
-                       for k, v in f["site"].attrs.items()}) if "site" in f else Site()
+        vals = {k: (attr_str(f, k) if k in ("algorithm", "epoch_utc") else attr_number(f, k, integer=k == "n_freq"))
+                for k in _SCALARS}
         img = GbsarImage(
             image=require(f, "image", path, shape_rank=3, dtype_kind="c"),
-            range_m=require(f, "range", path, shape_rank=1)[()],
-            azimuth_m=require(f, "azimuth", path, shape_rank=1)[()],
-            algorithm_map=require(f, "algorithm_map", path, shape_rank=2)[()],
+            range_m=read_array(f, "range", "f", ndim=1, finite=False),
+            azimuth_m=read_array(f, "azimuth", "f", ndim=1, finite=False),
+            algorithm_map=read_array(f, "algorithm_map", "iu", ndim=2),
             polarizations=tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p),
-            site=site, report=json.loads(attr_str(f, "report") or "{}"),
-            permittivity=float(f.attrs.get("permittivity", 1.0)),
-            grid_z_m=float(f.attrs["grid_z_m"]) if "grid_z_m" in f.attrs else None, **vals)
-        if img.image.shape[1:] != (img.range_m.size, img.azimuth_m.size) or \
-                img.image.shape[0] != len(img.polarizations):
-            raise ProductError(f"{path}: malformed gbsar_image, image shape does not match its axes")
+            site=read_attr_group(f, "site", Site), report=attr_json(f, "report", {}),
+            permittivity=attr_number(f, "permittivity", 1.0),
+            grid_z_m=attr_number(f, "grid_z_m") if "grid_z_m" in f.attrs else None, **vals)
+        img.validate(str(path), pixels=False)
         yield img
 
 
 def read_gbsar_image(path: str | os.PathLike) -> GbsarImage:
-    with open_gbsar_image(path) as img:
-        return dataclasses.replace(img, image=img.image[()])
+    """Read and validate (:meth:`GbsarImage.validate`) an image product; ProductError (one line) otherwise."""
+    with open_gbsar_image(path) as lazy:
+        img = dataclasses.replace(lazy, image=lazy.image[()])
+    img.validate(str(path))
+    return img

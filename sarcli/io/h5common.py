@@ -37,6 +37,7 @@ from sarcli import __version__
 from sarcli.errors import ProductError
 from sarcli.io.atomic import atomic_path
 from sarcli.io.provenance import current
+from sarcli.model import checks as ck
 
 CONVENTIONS = "CF-1.8"
 #: the NAME of a netCDF-4 dimension that has no coordinate values (netCDF's and h5netcdf's convention)
@@ -168,6 +169,7 @@ def atomic_h5(
             f.attrs["Conventions"] = CONVENTIONS
             yield f
             label_remaining_dimensions(f)
+    _probed.add(_version_key(path))  # written here and now: reading it back needs no probe
 
 
 def dataset(
@@ -273,30 +275,214 @@ def group(parent: h5py.Group, name: str) -> h5py.Group:
     return h5py.Group(gid)
 
 
+def _raised_by_h5py(e: BaseException) -> bool:
+    """True when the innermost frame of ``e``'s traceback is h5py's (a damaged file, not a sarcli bug)."""
+    tb, last = e.__traceback__, None
+    while tb is not None:
+        last, tb = tb.tb_frame.f_code.co_filename, tb.tb_next
+    return last is not None and "h5py" in Path(last).parts
+
+
+def _h5_reason(e: BaseException) -> str:
+    msg = " ".join(str(e).split())
+    return f"{e.__class__.__name__}: {msg[:160]}" if msg else e.__class__.__name__
+
+
+#: Seconds a metadata probe may take (a small product's metadata read in milliseconds; a damaged one
+#: can send the HDF5 library into an endless loop, e.g. a global-heap object size bit-flipped).
+PROBE_TIMEOUT_S = 20.0
+_probed: set[tuple] = set()
+
+
+def _version_key(path: str | os.PathLike) -> tuple[int, int, int, int]:
+    st = os.stat(path)
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def _walk_metadata(path: Path) -> None:
+    """Read every attribute and every dataset's shape, type and chunk index (no data): what a reader
+    touches before the samples."""
+    with h5py.File(path, "r") as f:
+        def visit(obj: Any) -> None:
+            for k in obj.attrs:
+                obj.attrs[k]
+            if isinstance(obj, h5py.Dataset):
+                obj.shape, obj.dtype  # noqa: B018
+                if obj.chunks is not None:
+                    obj.id.get_num_chunks()
+        visit(f)
+        f.visititems(lambda name, obj: visit(obj))
+
+
+def probe_metadata(path: str | os.PathLike) -> None:
+    """Refuse (one line) an HDF5 file whose metadata send the HDF5 library into a hang or a crash.
+
+    A hang in C code cannot be interrupted from Python, so the metadata are first walked
+    (:func:`_walk_metadata`) in another process that is killed after :data:`PROBE_TIMEOUT_S`; errors
+    the walk meets are left to the caller, which meets them again in-process and reports them. The
+    walk runs in a child forked by a small helper interpreter (:func:`_probe_server`, started once per
+    process): forking the caller itself would copy its threads' locks (numba, OpenMP, h5py's own) into
+    the child and cost tens of milliseconds. Once per file version (device, inode, size, modification
+    time) and process; a no-op where ``fork`` is not available.
+    """
+    key = _version_key(path)
+    if key in _probed or not hasattr(os, "fork"):
+        return
+    verdict = _PROBER.ask(os.path.abspath(path), PROBE_TIMEOUT_S)
+    if verdict == "hang":
+        raise ProductError(f"{path}: damaged HDF5 product: reading its metadata does not finish "
+                           f"(given up after {PROBE_TIMEOUT_S:g} s)")
+    if verdict != "ok":
+        raise ProductError(f"{path}: damaged HDF5 product: reading its metadata crashes the HDF5 library"
+                           f" ({verdict})")
+    _probed.add(key)
+
+
+def _probe_server() -> None:  # pragma: no cover - runs in the helper interpreter
+    """The helper's loop: one JSON request ``[timeout_s, path]`` per line on stdin, one verdict per line
+    on stdout: ``ok``, ``hang`` (the walk was killed after the timeout) or ``signal N`` / ``died``."""
+    import select
+    import signal
+    import sys
+
+    for line in sys.stdin:
+        timeout, path = json.loads(line)
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            try:
+                os.close(r)
+                signal.alarm(int(timeout) + 2)  # SIGALRM's default action ends the walk even if the helper died
+                with contextlib.suppress(BaseException):
+                    _walk_metadata(Path(path))
+                os.write(w, b"done")
+            finally:
+                os._exit(0)
+        os.close(w)
+        ready, _, _ = select.select([r], [], [], timeout)
+        answer = os.read(r, 16) if ready else b""
+        os.close(r)
+        if not ready:
+            os.kill(pid, signal.SIGKILL)
+        _, status = os.waitpid(pid, 0)
+        if answer == b"done":
+            verdict = "ok"
+        elif not ready:
+            verdict = "hang"
+        else:
+            verdict = f"signal {os.WTERMSIG(status)}" if os.WIFSIGNALED(status) else "died"
+        sys.stdout.write(verdict + "\n")
+        sys.stdout.flush()
+
+
+class _Prober:
+    """The caller's side of the helper interpreter (started on first use, restarted if it dies)."""
+
+    def __init__(self) -> None:
+        import threading
+
+        self.proc: Any = None
+        self.registered = False
+        self.lock = threading.Lock()
+
+    def _start(self) -> None:
+        import subprocess
+        import sys
+
+        code = (f"import sys; sys.path[:0] = {sys.path!r}; "
+                "from sarcli.io.h5common import _probe_server; _probe_server()")
+        self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     text=True, bufsize=1)
+        if not self.registered:
+            import atexit
+
+            atexit.register(self._stop)
+            self.registered = True
+
+    def _stop(self) -> None:
+        """End the helper (its loop ends with its stdin; killed if it does not within a second)."""
+        proc, self.proc = self.proc, None
+        if proc is None:
+            return
+        with contextlib.suppress(OSError):
+            proc.stdin.close()
+        try:
+            proc.wait(timeout=1.0)
+        except Exception:
+            proc.kill()
+            proc.wait()
+        with contextlib.suppress(OSError):
+            proc.stdout.close()
+
+    def ask(self, path: str, timeout: float) -> str:
+        import select
+
+        with self.lock:
+            if self.proc is None or self.proc.poll() is not None:
+                self._start()
+            try:
+                self.proc.stdin.write(json.dumps([timeout, path]) + "\n")
+                self.proc.stdin.flush()
+                ready, _, _ = select.select([self.proc.stdout], [], [], timeout + 30.0)
+                line = self.proc.stdout.readline() if ready else ""
+            except BaseException:  # interrupted mid-request: its answer would be read by the next one
+                self._stop()
+                raise
+            if not line:  # the helper itself hung or died: start afresh next time
+                self._stop()
+                return "hang" if not ready else "helper died"
+            return line.strip()
+
+
+_PROBER = _Prober()
+
+
 @contextlib.contextmanager
 def open_product(path: str | os.PathLike, product_type: str | Sequence[str] | None = None,
                  mode: str = "r") -> Iterator[h5py.File]:
-    """Open an existing product, refusing (one line) a missing, non-HDF5 or wrong-type file."""
+    """Open an existing product, refusing (one line) a missing, non-HDF5 or wrong-type file.
+
+    The file's metadata are probed first in a child process (:func:`probe_metadata`): a damaged file
+    that would hang or crash the HDF5 library is refused in one line. Inside the block, any error that
+    h5py raises (a truncated or damaged file: OSError, KeyError, RuntimeError, ...) becomes one
+    :class:`ProductError` line naming the file.
+    """
     path = Path(path)
     if not path.exists():
         raise ProductError(f"{path}: no such file")
+    if path.is_file():
+        probe_metadata(path)
     try:
         f = h5py.File(path, mode)
-    except OSError as e:
-        raise ProductError(f"{path}: not a readable HDF5 product ({e.__class__.__name__})") from None
+    except Exception as e:  # h5py: OSError for a non-HDF5/truncated file, others for damaged superblocks
+        if not (isinstance(e, OSError) or _raised_by_h5py(e)):
+            raise
+        raise ProductError(f"{path}: not a readable HDF5 product ({_h5_reason(e)})") from None
     try:
         ptype = f.attrs.get("product_type")
-        if isinstance(ptype, bytes):
-            ptype = ptype.decode()
         if ptype is None:
             raise ProductError(f"{path}: not a sarcli product (no product_type attribute)")
+        ptype = ck.text(str(path), "product_type", ptype)
         if product_type is not None:
             wanted = [product_type] if isinstance(product_type, str) else list(product_type)
             if ptype not in wanted:
                 raise ProductError(f"{path}: is a '{ptype}' product, expected {' or '.join(wanted)}")
         yield f
+    except ProductError:
+        raise
+    except Exception as e:
+        if not _raised_by_h5py(e):
+            raise
+        raise ProductError(f"{path}: damaged HDF5 product, cannot read it ({_h5_reason(e)})") from None
     finally:
-        f.close()
+        with contextlib.suppress(Exception):
+            f.close()
+
+
+def _label(obj: h5py.HLObject) -> str:
+    """``file: /group`` for messages about an object of a product."""
+    name = obj.name if obj.name not in (None, "/") else ""
+    return f"{obj.file.filename}{': ' + name.lstrip('/') if name else ''}"
 
 
 def require(f: h5py.Group, name: str, path: str | os.PathLike, shape_rank: int | None = None,
@@ -314,24 +500,76 @@ def require(f: h5py.Group, name: str, path: str | os.PathLike, shape_rank: int |
     return ds
 
 
+def read_array(g: h5py.Group, name: str, kind: str = "f", ndim: int | None = None,
+               shape: tuple[int | None, ...] | None = None, finite: bool = True, min_size: int = 0,
+               required: bool = True) -> np.ndarray | None:
+    """A dataset's values, checked (:func:`sarcli.model.checks.array`: dtype kind, rank or shape, size,
+    finiteness); a missing optional dataset gives None, a missing required one a ProductError."""
+    if name not in g:
+        if required:
+            raise ProductError(f"{_label(g)}: malformed product, missing '{name}'")
+        return None
+    ds = g[name]
+    if not isinstance(ds, h5py.Dataset):
+        raise ProductError(f"{_label(g)}: malformed product, '{name}' is not a dataset")
+    where = _label(g)
+    # dtype and rank first: no point reading a string table where numbers belong
+    ck.array(where, name, np.empty((0,) * ds.ndim, ds.dtype), kind, ndim, finite=False)
+    return ck.array(where, name, ds[()], kind, ndim, shape, finite, min_size)
+
+
+_MISSING = object()
+
+
+def attr_value(obj: h5py.HLObject, key: str, default: Any = _MISSING) -> Any:
+    """An attribute's value; a missing one is ``default`` or, without a default, one ProductError line."""
+    if key not in obj.attrs:
+        if default is _MISSING:
+            raise ProductError(f"{_label(obj)}: malformed product, attribute '{key}' missing")
+        return default
+    return obj.attrs[key]
+
+
+def attr_number(obj: h5py.HLObject, key: str, default: Any = _MISSING, lo: float | None = None,
+                hi: float | None = None, integer: bool = False, unit: str = "") -> Any:
+    """A numeric scalar attribute (text, arrays, NaN, values outside [lo, hi] refused in one line)."""
+    v = attr_value(obj, key, default)
+    if v is default and default is not _MISSING:
+        return default
+    return ck.number(_label(obj), key, v, lo, hi, integer, unit)
+
+
 def attr_str(obj: h5py.HLObject, key: str, default: str | None = None) -> str | None:
-    """Read a string attribute (bytes or str) or ``default``."""
-    v = obj.attrs.get(key, default)
-    if isinstance(v, bytes):
-        return v.decode()
-    return v if v is None else str(v)
+    """A text attribute (bytes or str, valid UTF-8; anything else is refused in one line) or ``default``."""
+    v = obj.attrs.get(key, None)
+    if v is None:
+        return default
+    return ck.text(_label(obj), key, v)
+
+
+def attr_json(obj: h5py.HLObject, key: str, default: Any = _MISSING, kind: type = dict) -> Any:
+    """A JSON text attribute decoded, of type ``kind`` (dict or list); bad JSON refused in one line."""
+    v = attr_value(obj, key, default)
+    if v is default and default is not _MISSING:
+        return default
+    s = ck.text(_label(obj), key, v)
+    try:
+        out = json.loads(s)
+    except (json.JSONDecodeError, RecursionError):
+        raise ProductError(f"{_label(obj)}: attribute '{key}' is not valid JSON") from None
+    if not isinstance(out, kind):
+        raise ProductError(f"{_label(obj)}: attribute '{key}' must be a JSON {kind.__name__}")
+    return out
 
 
 def provenance(f: h5py.File) -> dict[str, Any]:
-    """The root provenance attributes, JSON fields decoded."""
+    """The root provenance attributes, JSON fields decoded (text that is not JSON is kept as text)."""
     out: dict[str, Any] = {}
     for k in PROVENANCE_ATTRS:
         v = attr_str(f, k)
         if k in ("inputs", "parameters") and v is not None:
-            try:
+            with contextlib.suppress(json.JSONDecodeError, RecursionError):
                 v = json.loads(v)
-            except json.JSONDecodeError:
-                pass
         out[k] = v
     return out
 
@@ -382,7 +620,11 @@ def write_mapping(parent: h5py.Group, name: str, mapping: dict[str, Any], epoch_
 
 
 def read_mapping(g: h5py.Group) -> dict[str, Any]:
-    """Inverse of :func:`write_mapping`."""
-    out: dict[str, Any] = {k: g[k][()] for k in g}
+    """Inverse of :func:`write_mapping` (datasets as arrays, text attributes checked as UTF-8)."""
+    out: dict[str, Any] = {}
+    for k in g:
+        if not isinstance(g[k], h5py.Dataset):
+            raise ProductError(f"{_label(g)}: malformed product, '{k}' is not a dataset")
+        out[k] = g[k][()]
     out.update({k: attr_str(g, k) for k in g.attrs})
     return out

@@ -30,10 +30,24 @@ from __future__ import annotations
 
 import json
 import os
+from typing import Any
 
+import h5py
 import numpy as np
 
-from sarcli.io.h5common import atomic_h5, attr_str, coordinate, dataset, group, open_product, require
+from sarcli.errors import ProductError
+from sarcli.io.h5common import (
+    atomic_h5,
+    attr_json,
+    attr_number,
+    attr_str,
+    coordinate,
+    dataset,
+    group,
+    open_product,
+    read_array,
+)
+from sarcli.model import checks as ck
 
 IFG_TYPE, PS_TYPE, SCHEMA_VERSION = "gbsar_interferogram", "gbsar_ps", "1"
 IFG_SCHEMA_VERSION = "2"
@@ -46,7 +60,7 @@ _IFG_DESCRIPTIONS = {
     "connected_component": "SNAPHU connected component of each pixel (0: none)"}
 
 
-def _axes(f, range_m: np.ndarray, azimuth_m: np.ndarray):
+def _write_axes(f, range_m: np.ndarray, azimuth_m: np.ndarray):
     return (coordinate(f, "range", np.asarray(range_m, np.float64), "m", "R0, distance from the rail line"),
             coordinate(f, "azimuth", np.asarray(azimuth_m, np.float64), "m", "x along the rail"))
 
@@ -60,7 +74,7 @@ def write_interferogram(path: str | os.PathLike, ifg, range_m: np.ndarray, azimu
         f.attrs["value_unit"] = ifg.value_unit
         f.attrs["rate"] = json.dumps(ifg.rate, default=float)
         f.attrs["unwrap_method"] = ifg.unwrap_method
-        dims = _axes(f, range_m, azimuth_m)
+        dims = _write_axes(f, range_m, azimuth_m)
         for name, arr, unit in (("phase", ifg.phase, "rad"), ("coherence", ifg.coherence, "1"),
                                 ("model_phase", ifg.model_phase, "rad"), ("residual_phase", ifg.residual, "rad"),
                                 ("unwrapped_phase", ifg.unwrapped, "rad")):
@@ -73,14 +87,49 @@ def write_interferogram(path: str | os.PathLike, ifg, range_m: np.ndarray, azimu
                 dims=dims)
 
 
-def read_interferogram(path: str | os.PathLike) -> dict:
-    """All datasets and attributes of an interferogram product as a dict of arrays / values."""
-    with open_product(path, IFG_TYPE) as f:
-        out = {k: require(f, k, path)[()] for k in ("phase", "coherence", "model_phase", "residual_phase", "value",
-                                                     "range", "azimuth")}
-        out.update({k: attr_str(f, k) if isinstance(f.attrs[k], str | bytes) else f.attrs[k] for k in f.attrs})
-    out["rate"] = json.loads(out["rate"])
+def _root_attrs(f: h5py.File) -> dict[str, Any]:
+    """Root attributes: text checked as UTF-8, numeric scalars as finite numbers, numeric arrays as they are."""
+    out: dict[str, Any] = {}
+    for k in f.attrs:
+        v = f.attrs[k]
+        if isinstance(v, str | bytes | np.bytes_):
+            out[k] = attr_str(f, k)
+        elif isinstance(v, np.ndarray) and v.ndim > 0:
+            out[k] = ck.array(f"{f.filename}", k, v, "fiu", finite=False)
+        else:
+            out[k] = attr_number(f, k)
     return out
+
+
+def _axes(f: h5py.File, path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    r = read_array(f, "range", "f", ndim=1, min_size=1)
+    x = read_array(f, "azimuth", "f", ndim=1, min_size=1)
+    ck.increasing(str(path), "range", r)
+    ck.increasing(str(path), "azimuth", x)
+    return r, x
+
+
+def read_interferogram(path: str | os.PathLike) -> dict:
+    """All datasets and attributes of an interferogram product as a dict of arrays / values; checked:
+    five float (n_range, n_azimuth) layers on finite increasing axes (NaN marks no support, as
+    documented), coherence within [0, 1], typed attributes, ``rate`` a JSON object."""
+    with open_product(path, IFG_TYPE) as f:
+        r, x = _axes(f, path)
+        out: dict[str, Any] = {"range": r, "azimuth": x}
+        for k in ("phase", "coherence", "model_phase", "residual_phase", "value"):
+            out[k] = read_array(f, k, "f", shape=(r.size, x.size), finite=False)
+        _unit_interval(path, "coherence", out["coherence"])
+        out.update(_root_attrs(f))
+        out["rate"] = attr_json(f, "rate", kind=dict)
+        for k in ("value_name", "value_unit"):
+            out[k] = attr_str(f, k) or ""
+    return out
+
+
+def _unit_interval(path: str | os.PathLike, name: str, a: np.ndarray) -> None:
+    fin = a[np.isfinite(a)]
+    if fin.size and (fin.min() < -1e-6 or fin.max() > 1 + 1e-6):
+        raise ProductError(f"{path}: {name} must lie within [0, 1]")
 
 
 def write_ps(path: str | os.PathLike, coherence: np.ndarray, time_s: np.ndarray, rows: np.ndarray, cols: np.ndarray,
@@ -89,7 +138,7 @@ def write_ps(path: str | os.PathLike, coherence: np.ndarray, time_s: np.ndarray,
     with atomic_h5(path, PS_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
         for k, v in attrs.items():
             f.attrs[k] = v
-        rg, az = _axes(f, range_m, azimuth_m)
+        rg, az = _write_axes(f, range_m, azimuth_m)
         dataset(f, "coherence", np.asarray(coherence, np.float32), units="1", compression="gzip",
                 description="temporal coherence |sum z_i| / sum |z_i|", dims=(rg, az))
         ts = coordinate(f, "time_s", np.asarray(time_s, np.float64), "s", "mean scan time after the reference "
@@ -111,7 +160,26 @@ def write_ps(path: str | os.PathLike, coherence: np.ndarray, time_s: np.ndarray,
 
 
 def read_ps(path: str | os.PathLike) -> dict:
+    """The temporal-coherence / persistent-scatterer product as a dict (``ps_<name>`` for /ps datasets);
+    checked: coherence (n_range, n_azimuth) within [0, 1] where defined, finite increasing axes and
+    times, PS pixel indices inside the grid, one phase and displacement per PS and scan."""
     with open_product(path, PS_TYPE) as f:
-        out = {k: require(f, k, path)[()] for k in ("coherence", "time_s", "range", "azimuth")}
-        out.update({f"ps_{k}": f["ps"][k][()] for k in f["ps"]})
+        r, x = _axes(f, path)
+        out: dict[str, Any] = {"range": r, "azimuth": x}
+        out["coherence"] = read_array(f, "coherence", "f", shape=(r.size, x.size), finite=False)
+        _unit_interval(path, "coherence", out["coherence"])
+        out["time_s"] = read_array(f, "time_s", "f", ndim=1, min_size=1)
+        if "ps" not in f or not isinstance(f["ps"], h5py.Group):
+            raise ProductError(f"{path}: malformed product, missing group 'ps'")
+        g = f["ps"]
+        rows = read_array(g, "row", "iu", ndim=1)
+        n_ps, n_t = rows.size, out["time_s"].size
+        cols = read_array(g, "col", "iu", shape=(n_ps,))
+        if n_ps and (rows.min() < 0 or rows.max() >= r.size or cols.min() < 0 or cols.max() >= x.size):
+            raise ProductError(f"{path}: ps/row or ps/col outside the {r.size} x {x.size} grid")
+        out.update({"ps_row": rows, "ps_col": cols})
+        for k in ("range", "azimuth", "coherence"):
+            out[f"ps_{k}"] = read_array(g, k, "f", shape=(n_ps,))
+        for k in ("phase", "displacement_mm"):
+            out[f"ps_{k}"] = read_array(g, k, "f", shape=(n_ps, n_t))
     return out

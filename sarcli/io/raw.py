@@ -50,63 +50,25 @@ from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     PROVENANCE_ATTRS,
     atomic_h5,
+    attr_number,
     attr_str,
     cf_time_units,
     coordinate,
     dataset,
     group,
     open_product,
+    read_array,
     read_mapping,
     require,
     units_from_name,
     write_mapping,
 )
+from sarcli.model import checks as ck
 from sarcli.model.constants import C_LIGHT
-from sarcli.model.raw import Attitude, Orbit, Radar, RawProduct
+from sarcli.model.raw import QUANTIZATION_BITS, Attitude, Orbit, Radar, RawProduct
 
 PRODUCT_TYPE = "raw"
 SCHEMA_VERSION = "1"
-ORBIT_FRAMES = ("ECI", "ECEF", "LOCAL")
-
-
-def _validate(p: RawProduct, where: str = "raw product") -> None:
-    e = p.echo
-    if e.ndim != 2 or e.shape[0] < 1 or e.shape[1] < 1:
-        raise ProductError(f"{where}: echo must be a non-empty 2-D array, got shape {e.shape}")
-    n_lines = e.shape[0]
-    if p.azimuth_time.shape != (n_lines,):
-        raise ProductError(f"{where}: azimuth_time has {p.azimuth_time.shape}, expected ({n_lines},)")
-    if n_lines > 1 and not np.all(np.diff(p.azimuth_time) > 0):
-        raise ProductError(f"{where}: azimuth times are not strictly increasing")
-    r = p.radar
-    for name in ("carrier_frequency_hz", "wavelength_m", "prf_hz", "range_sampling_rate_hz",
-                 "pulse_length_s", "first_range_m"):
-        v = getattr(r, name)
-        if not (np.isfinite(v) and v > 0):
-            raise ProductError(f"{where}: radar.{name} must be positive and finite, got {v}")
-    if not np.isfinite(r.chirp_rate_hz_per_s) or r.chirp_rate_hz_per_s == 0:
-        raise ProductError(f"{where}: radar.chirp_rate_hz_per_s must be non-zero and finite")
-    if p.look_side not in ("right", "left"):
-        raise ProductError(f"{where}: look_side must be 'right' or 'left', got {p.look_side!r}")
-    for name in ("prf_per_line", "agc_db"):
-        a = getattr(p, name)
-        if a is not None and a.shape != (n_lines,):
-            raise ProductError(f"{where}: {name} has shape {a.shape}, expected ({n_lines},)")
-    if p.echo_channels is not None:
-        if p.echo_channels.ndim != 3 or p.echo_channels.shape[1:] != e.shape:
-            raise ProductError(f"{where}: echo_channels shape {p.echo_channels.shape} does not match echo")
-        if len(r.receiver_offsets_m) != p.n_channels:
-            raise ProductError(f"{where}: receiver_offsets_m needs {p.n_channels} values")
-    if p.orbit is not None:
-        o = p.orbit
-        if o.frame not in ORBIT_FRAMES:
-            raise ProductError(f"{where}: orbit frame {o.frame!r} is not one of {ORBIT_FRAMES}")
-        n = o.time.shape[0]
-        if o.time.ndim != 1 or o.position.shape != (n, 3) or o.velocity.shape != (n, 3):
-            raise ProductError(f"{where}: orbit arrays must be (n,), (n,3), (n,3)")
-        if not (np.all(np.isfinite(o.time)) and np.all(np.isfinite(o.position))
-                and np.all(np.isfinite(o.velocity))):
-            raise ProductError(f"{where}: orbit state vectors contain NaN or inf")
 
 
 #: HDF5 compression of the echo: ``auto`` (shuffle + gzip level 1 where it pays, :func:`echo_compression`),
@@ -150,9 +112,12 @@ def echo_compression(echo: np.ndarray, compression: str | None = "auto") -> str 
 
 def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = None,
               inputs: tuple = (), compression: str | None = "auto") -> None:
-    """Validate and write ``p`` atomically to ``path`` (``compression``: one of :data:`COMPRESSIONS`,
-    None = ``auto``)."""
-    _validate(p)
+    """Validate (:meth:`RawProduct.validate`) and write ``p`` atomically to ``path`` (``compression``: one
+    of :data:`COMPRESSIONS`, None = ``auto``).
+
+    NaN or inf samples are written as given (a tool may store them on purpose); :func:`read_raw`
+    refuses them."""
+    p.validate(str(path), finite_samples=False)
     n_lines, n_samples = p.echo.shape
     filt = echo_compression(p.echo, compression)
     tunits = cf_time_units(p.epoch_utc)
@@ -209,20 +174,23 @@ def write_radar(f: h5py.Group, radar: Radar) -> h5py.Group:
 
 
 def read_radar(g: h5py.Group, path: str | os.PathLike) -> Radar:
-    """Inverse of :func:`write_radar`; a missing required attribute is refused in one line."""
+    """Inverse of :func:`write_radar`: every attribute type-checked (a string, array or NaN where a number
+    belongs is refused in one line); a missing required attribute is refused in one line. Plausibility
+    is :meth:`Radar.validate`'s job."""
     kw: dict[str, Any] = {}
     for fld in dataclasses.fields(Radar):
-        if fld.name in g.attrs:
+        if fld.name not in g.attrs:
+            if fld.default is dataclasses.MISSING:
+                raise ProductError(f"{path}: malformed product, radar attribute '{fld.name}' missing")
+            continue
+        if fld.name == "receiver_offsets_m":
             v = g.attrs[fld.name]
-            if fld.name == "receiver_offsets_m":
-                v = tuple(float(x) for x in np.atleast_1d(v))
-            elif fld.name == "quantization_bits":
-                v = int(v)
-            else:
-                v = float(v)
-            kw[fld.name] = v
-        elif fld.default is dataclasses.MISSING:
-            raise ProductError(f"{path}: malformed product, radar attribute '{fld.name}' missing")
+            a = ck.array(f"{path}: radar", fld.name, np.atleast_1d(v), "f", ndim=1, min_size=1)
+            kw[fld.name] = tuple(float(x) for x in a)
+        elif fld.name == "quantization_bits":
+            kw[fld.name] = attr_number(g, fld.name, lo=QUANTIZATION_BITS[0], hi=QUANTIZATION_BITS[1], integer=True)
+        else:
+            kw[fld.name] = attr_number(g, fld.name)
     return Radar(**kw)
 
 
@@ -272,71 +240,114 @@ def write_platform(f: h5py.Group, orbit: Orbit | None, attitude: Attitude | None
 
 
 def read_platform(f: h5py.Group, path: str | os.PathLike) -> tuple[Orbit | None, Attitude | None]:
-    """Inverse of :func:`write_platform` (missing groups -> None)."""
+    """Inverse of :func:`write_platform` (missing groups -> None); arrays type-checked, the models'
+    ``validate`` checks the rest."""
     orbit = attitude = None
     if "orbit" in f:
-        og = f["orbit"]
-        orbit = Orbit(require(og, "time", path)[()], require(og, "position", path)[()],
-                      require(og, "velocity", path)[()], attr_str(og, "frame", "ECI"))
+        og = _subgroup(f, "orbit", path)
+        orbit = Orbit(read_array(og, "time", "f", ndim=1, finite=False),
+                      read_array(og, "position", "f", ndim=2, finite=False),
+                      read_array(og, "velocity", "f", ndim=2, finite=False), attr_str(og, "frame", "ECI"))
     if "attitude" in f:
-        ag = f["attitude"]
-        attitude = Attitude(*(require(ag, k, path)[()] for k in ("time", "pitch", "roll", "yaw")))
+        ag = _subgroup(f, "attitude", path)
+        attitude = Attitude(*(read_array(ag, k, "f", ndim=1, finite=False) for k in ("time", "pitch", "roll", "yaw")))
     return orbit, attitude
 
 
-def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
-    """Read and validate a raw product; a malformed file raises :class:`ProductError` (one line).
+def _subgroup(f: h5py.Group, name: str, path: str | os.PathLike) -> h5py.Group:
+    g = f[name]
+    if not isinstance(g, h5py.Group):
+        raise ProductError(f"{path}: malformed product, '{name}' is not a group")
+    return g
 
-    With ``load_echo=False`` the echo comes back as an empty (n_lines, 0) array and the metadata
-    only; use :func:`read_raw_echo_block` to stream lines in bounded memory.
+
+def _extra_attrs(f: h5py.File, standard: set[str], path: str | os.PathLike) -> dict[str, Any]:
+    """The root attributes a reader does not interpret (sensor metadata), carried to derived products:
+    text checked as UTF-8 (it is written again), numbers and numeric arrays as they are."""
+    out: dict[str, Any] = {}
+    for k in f.attrs:
+        if k in standard:
+            continue
+        v = f.attrs[k]
+        if isinstance(v, str | bytes | np.bytes_):
+            v = attr_str(f, k)
+        elif isinstance(v, np.ndarray) and v.dtype.kind in "OSU":
+            v = np.array([ck.text(f"{path}", k, x) for x in v.ravel()], dtype=object).reshape(v.shape)
+        out[k] = v
+    return out
+
+
+def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
+    """Read and validate a raw product; a malformed or implausible file raises :class:`ProductError`
+    (one line; :meth:`RawProduct.validate` lists the checks).
+
+    With ``load_echo=False`` the echo comes back as an empty (n_lines, 0) array (further channels as
+    (n_channels - 1, n_lines, 0)) and everything else is read and validated; use
+    :func:`read_raw_echo_block` to stream lines in bounded memory.
     """
     with open_product(path, PRODUCT_TYPE) as f:
         sv = attr_str(f, "schema_version")
         if sv != SCHEMA_VERSION:
             raise ProductError(f"{path}: raw schema version {sv} is not supported (expected {SCHEMA_VERSION})")
         echo_ds = require(f, "echo", path, shape_rank=2, dtype_kind="c")
-        t = require(f, "azimuth_time", path, shape_rank=1, dtype_kind="f")[()]
+        n_lines, n_samples = echo_ds.shape
+        t = read_array(f, "azimuth_time", "f", ndim=1, finite=False)
         if "radar" not in f:
             raise ProductError(f"{path}: malformed product, missing 'radar'")
-        g = f["radar"]
+        g = _subgroup(f, "radar", path)
         radar = read_radar(g, path)
-        echo = echo_ds[()] if load_echo else np.zeros((echo_ds.shape[0], 0), np.complex64)
-        echo_channels = f["echo_channels"][()] if ("echo_channels" in f and load_echo) else None
+        echo_channels = ch = None
+        if "echo_channels" in f:
+            ch = require(f, "echo_channels", path, shape_rank=3, dtype_kind="c")
+            if ch.shape[1:] != (n_lines, n_samples):
+                raise ProductError(f"{path}: echo_channels has shape {ch.shape}, echo {echo_ds.shape}")
+            echo_channels = np.zeros((ch.shape[0], n_lines, 0), np.complex64)
         orbit, attitude = read_platform(f, path)
-        truth = read_mapping(f["truth"]) if "truth" in f else None
+        if "truth" in f:
+            truth = read_mapping(_subgroup(f, "truth", path))
+        else:
+            truth = None
+        epoch = attr_str(f, "epoch_utc")
+        if epoch is None:
+            raise ProductError(f"{path}: malformed product, epoch_utc missing")
         p = RawProduct(
-            echo=echo, azimuth_time=t, epoch_utc=attr_str(f, "epoch_utc") or "", radar=radar,
+            echo=np.zeros((n_lines, 0), np.complex64), azimuth_time=t, epoch_utc=epoch, radar=radar,
             look_side=attr_str(f, "look_side", "right"), source=attr_str(f, "source", "unknown"),
             echo_channels=echo_channels,
-            prf_per_line=g["prf_per_line"][()] if "prf_per_line" in g else None,
-            agc_db=g["agc_db"][()] if "agc_db" in g else None,
-            replica=g["replica"][()] if "replica" in g else None,
+            prf_per_line=read_array(g, "prf_per_line", "f", ndim=1, finite=False, required=False),
+            agc_db=read_array(g, "agc_db", "f", ndim=1, finite=False, required=False),
+            replica=read_array(g, "replica", "c", ndim=1, finite=False, required=False),
             orbit=orbit, attitude=attitude, truth=truth,
         )
         if "auxiliary" in f:
-            f["auxiliary"].visititems(
+            _subgroup(f, "auxiliary", path).visititems(
                 lambda name, obj: p.auxiliary.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
-        standard = set(PROVENANCE_ATTRS) | {"Conventions", "epoch_utc", "look_side", "source", "n_channels"}
-        p.extra_attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()
-                         if k not in standard}
-        if not p.epoch_utc:
-            raise ProductError(f"{path}: malformed product, epoch_utc missing")
+        n_ch = attr_number(f, "n_channels", p.n_channels, lo=1, integer=True)
+        if n_ch != p.n_channels:
+            raise ProductError(f"{path}: n_channels says {n_ch}, the product holds {p.n_channels} channel(s)")
+        p.extra_attrs = _extra_attrs(f, set(PROVENANCE_ATTRS) | {"Conventions", "epoch_utc", "look_side", "source",
+                                                                    "n_channels"},
+                                     path)
+        p.validate(str(path), n_samples=n_samples)  # everything but the samples, before reading them
         if load_echo:
-            _validate(p, str(path))
-        if load_echo and not np.all(np.isfinite(p.echo.view(np.float32))):
-            raise ProductError(f"{path}: echo contains NaN or inf samples")
+            p.echo = ck.array(str(path), "echo", echo_ds[()], "c")
+            if ch is not None:
+                p.echo_channels = ck.array(str(path), "echo_channels", ch[()], "c")
         return p
 
 
 def read_raw_echo_block(path: str | os.PathLike, start: int, stop: int, channel: int = 0) -> np.ndarray:
-    """Lines ``start:stop`` of one channel's echo, for block processing in bounded memory."""
+    """Lines ``start:stop`` of one channel's echo, for block processing in bounded memory (NaN or inf
+    samples are refused in one line)."""
     with open_product(path, PRODUCT_TYPE) as f:
         if channel == 0:
-            return require(f, "echo", path, shape_rank=2)[start:stop]
-        return f["echo_channels"][channel - 1, start:stop]
+            block = require(f, "echo", path, shape_rank=2, dtype_kind="c")[start:stop]
+        else:
+            block = require(f, "echo_channels", path, shape_rank=3, dtype_kind="c")[channel - 1, start:stop]
+        return ck.array(str(path), "echo" if channel == 0 else "echo_channels", block, "c")
 
 
 def raw_shape(path: str | os.PathLike) -> tuple[int, int]:
     """(n_lines, n_samples) without reading the echo."""
     with open_product(path, PRODUCT_TYPE) as f:
-        return tuple(require(f, "echo", path, shape_rank=2).shape)  # type: ignore[return-value]
+        return tuple(require(f, "echo", path, shape_rank=2, dtype_kind="c").shape)  # type: ignore[return-value]

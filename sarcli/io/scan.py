@@ -40,6 +40,7 @@ instead of focusing it as a straight rail.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Any
 
@@ -49,42 +50,24 @@ import numpy as np
 from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     atomic_h5,
+    attr_number,
     attr_str,
     cf_time_units,
     coordinate,
     dataset,
     group,
     open_product,
+    read_array,
     read_mapping,
     require,
     write_mapping,
 )
-from sarcli.model.gbsar import Antenna, Scan, Site
+from sarcli.model.gbsar import POLARIZATIONS, Antenna, Scan, Site
 
 PRODUCT_TYPE = "gbsar_scan"
 SCHEMA_VERSION = "1"
 SCHEMA_VERSION_TRACK = "2"  # with antenna_position and/or reference_range
-POLARIZATIONS = ("VV", "VH", "HV", "HH")
-
-
-def _validate(s: Scan, where: str) -> None:
-    if s.s21.ndim != 3:
-        raise ProductError(f"{where}: s21 must be (n_pol, n_stops, n_freq), got shape {s.s21.shape}")
-    n_pol, n_stops, n_freq = s.s21.shape
-    if n_pol != len(s.polarizations) or any(p not in POLARIZATIONS for p in s.polarizations):
-        raise ProductError(f"{where}: polarizations {s.polarizations} do not match s21's {n_pol} planes")
-    if s.frequency.shape != (n_freq,):
-        raise ProductError(f"{where}: frequency has shape {s.frequency.shape}, expected ({n_freq},)")
-    if n_freq > 1 and not np.all(np.diff(s.frequency) > 0):
-        raise ProductError(f"{where}: frequencies must be strictly increasing")
-    for name in ("rail_position", "rail_height"):
-        if getattr(s, name).shape != (n_stops,):
-            raise ProductError(f"{where}: {name} must have {n_stops} values")
-    if s.antenna_position is not None and np.shape(s.antenna_position) != (n_stops, 3):
-        raise ProductError(f"{where}: antenna_position has shape {np.shape(s.antenna_position)}, "
-                           f"expected ({n_stops}, 3)")
-    if s.reference_range is not None and np.shape(s.reference_range) != (n_stops,):
-        raise ProductError(f"{where}: reference_range must have {n_stops} values")
+__all__ = ["POLARIZATIONS", "PRODUCT_TYPE", "ScanWriter", "read_attr_group", "read_scan", "write_scan"]
 
 
 _DESCRIPTIONS = {"s21": "S21 per polarization, rail stop, frequency",
@@ -142,8 +125,8 @@ def _stop_axes(f: h5py.File, s: Scan | None, n: int, pol: h5py.Dataset, freq: h5
 
 
 def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None, inputs: tuple = ()) -> None:
-    """Validate and write a complete scan atomically."""
-    _validate(s, str(path))
+    """Validate (:meth:`Scan.validate`) and write a complete scan atomically."""
+    s.validate(str(path))
     n_stops = s.n_stops
     version = SCHEMA_VERSION if s.is_rail else SCHEMA_VERSION_TRACK
     with atomic_h5(path, PRODUCT_TYPE, version, parameters, inputs) as f:
@@ -154,48 +137,74 @@ def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None,
         _stop_axes(f, s, n_stops, pol, freq, resizable=False)
 
 
-def read_scan(path: str | os.PathLike) -> Scan:
-    """Read a scan (only its ``n_complete`` valid stops); a malformed file raises ProductError."""
+def read_attr_group(f: h5py.Group, name: str, cls: type) -> Any:
+    """A dataclass (:class:`Site`, :class:`Antenna`) from a group's attributes: unknown attributes are
+    refused, text checked as UTF-8, numbers as finite scalars (the dataclass's ``validate`` checks the
+    values); a missing group gives the defaults."""
+    if name not in f:
+        return cls()
+    g = f[name]
+    if not isinstance(g, h5py.Group):
+        raise ProductError(f"{f.file.filename}: malformed product, '{name}' is not a group")
+    fields = {fl.name: fl.type for fl in dataclasses.fields(cls)}
+    kw: dict[str, Any] = {}
+    for k in g.attrs:
+        if k not in fields:
+            raise ProductError(f"{f.file.filename}: {name} has an unknown attribute '{k}'")
+        kw[k] = attr_str(g, k) if fields[k] in (str, "str") else attr_number(g, k)
+    return cls(**kw)
+
+
+def _instrument(f: h5py.Group) -> dict[str, Any]:
+    """Instrument settings: free-form scalars (text or numbers)."""
+    if "instrument" not in f:
+        return {}
+    g = f["instrument"]
+    out: dict[str, Any] = {}
+    for k in g.attrs:
+        v = g.attrs[k]
+        if isinstance(v, str | bytes | np.bytes_):
+            out[k] = attr_str(g, k)
+        elif isinstance(v, np.bool_ | bool):
+            out[k] = bool(v)
+        else:
+            out[k] = attr_number(g, k, integer=isinstance(v, np.integer | int))
+    return out
+
+
+def read_scan(path: str | os.PathLike, min_usable_stops: int = 0) -> Scan:
+    """Read a scan (its ``n_complete`` valid stops) and validate it (:meth:`Scan.validate`); a malformed
+    or implausible file raises ProductError (one line). Focusing needs ``min_usable_stops=2``; an
+    interrupted acquisition may hold fewer and is still a valid file."""
     with open_product(path, PRODUCT_TYPE) as f:
         version = attr_str(f, "schema_version")
         if version not in (SCHEMA_VERSION, SCHEMA_VERSION_TRACK):
             raise ProductError(f"{path}: unsupported gbsar_scan schema version {version}")
-        n = int(f.attrs.get("n_complete", 0))
-        s21 = require(f, "s21", path, shape_rank=3, dtype_kind="c")[:, :n, :]
-        pols = tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p)
-
-        def attrs(name: str) -> dict[str, Any]:
-            if name not in f:
-                return {}
-            return {k: (v.decode() if isinstance(v, bytes) else v.item() if hasattr(v, "item") else v)
-                    for k, v in f[name].attrs.items()}
-
-        truth = read_mapping(f["truth"]) if "truth" in f else None
-        track = {}
+        s21_ds = require(f, "s21", path, shape_rank=3, dtype_kind="c")
+        n = attr_number(f, "n_complete", lo=0, hi=s21_ds.shape[1], integer=True)
+        per_stop = {}
+        for name, kind in (("rail_position", "f"), ("rail_height", "f"), ("stop_time", "f"), ("stop_flags", "iu")):
+            a = read_array(f, name, kind, ndim=1, finite=False)
+            if a.shape[0] < n:
+                raise ProductError(f"{path}: {name} has {a.shape[0]} value(s) for {n} complete stops")
+            per_stop[name] = a[:n]
         if version == SCHEMA_VERSION_TRACK:
-            if "antenna_position" in f:
-                track["antenna_position"] = require(f, "antenna_position", path, shape_rank=2)[:n]
-            if "reference_range" in f:
-                track["reference_range"] = require(f, "reference_range", path, shape_rank=1)[:n]
+            for name, ndim in (("antenna_position", 2), ("reference_range", 1)):
+                if name in f:
+                    a = read_array(f, name, "f", ndim=ndim, finite=False)
+                    if a.shape[0] < n:
+                        raise ProductError(f"{path}: {name} has {a.shape[0]} value(s) for {n} complete stops")
+                    per_stop[name] = a[:n]
+        pols = tuple(p for p in (attr_str(f, "polarizations") or "").split(",") if p)
         s = Scan(
-            s21=s21,
-            frequency=require(f, "frequency", path, shape_rank=1)[()],
-            rail_position=require(f, "rail_position", path, shape_rank=1)[:n],
-            rail_height=require(f, "rail_height", path, shape_rank=1)[:n],
-            polarizations=pols,
-            epoch_utc=attr_str(f, "epoch_utc") or "",
-            stop_time=require(f, "stop_time", path, shape_rank=1)[:n],
-            stop_flags=require(f, "stop_flags", path, shape_rank=1)[:n],
-            site=Site(**attrs("site")),
-            antenna=Antenna(**attrs("antenna")),
-            instrument=attrs("instrument"),
-            truth=truth,
-            source=attr_str(f, "source", "unknown"),
-            status=attr_str(f, "status", "unknown"),
-            n_planned=int(f.attrs.get("n_planned", n)),
-            **track,
+            s21=s21_ds[:, :n, :], frequency=read_array(f, "frequency", "f", ndim=1, finite=False),
+            polarizations=pols, epoch_utc=attr_str(f, "epoch_utc") or "",
+            site=read_attr_group(f, "site", Site), antenna=read_attr_group(f, "antenna", Antenna),
+            instrument=_instrument(f), truth=read_mapping(f["truth"]) if "truth" in f else None,
+            source=attr_str(f, "source", "unknown"), status=attr_str(f, "status", "unknown"),
+            n_planned=attr_number(f, "n_planned", n, lo=0, integer=True), **per_stop,
         )
-    _validate(s, str(path))
+    s.validate(str(path), min_usable_stops)
     return s
 
 
@@ -226,9 +235,8 @@ class ScanWriter:
 
     @classmethod
     def resume(cls, path: str | os.PathLike) -> ScanWriter:
-        """Reopen an interrupted scan for appending."""
-        with open_product(path, PRODUCT_TYPE):
-            pass
+        """Reopen an interrupted scan for appending (validated first: :func:`read_scan`)."""
+        read_scan(path)
         return cls(path)
 
     def append(self, s21_stop: np.ndarray, position_m: float, height_m: float, time_s: float,

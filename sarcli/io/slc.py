@@ -39,22 +39,28 @@ from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     atomic_h5,
     attach,
+    attr_json,
+    attr_number,
     attr_str,
     cf_time_units,
     coordinate,
     dataset,
     group,
     open_product,
+    read_array,
     read_mapping,
     require,
     to_jsonable,
     write_mapping,
 )
 from sarcli.io.raw import read_platform, read_radar, write_platform, write_radar
+from sarcli.model import checks as ck
+from sarcli.model.raw import LOOK_SIDES
 from sarcli.model.slc import SLC, DopplerUsed
 
 PRODUCT_TYPE = "slc"
 SCHEMA_VERSION = "1"
+AXIS_RTOL = 0.1  # zero-Doppler times and slant ranges are uniform grids: each step the mean step within 10 %
 
 
 #: heights (m above the WGS-84 ellipsoid) of the geolocation grid's layers (NISAR's grid spans -500..9000 m)
@@ -177,34 +183,63 @@ def write_slc(path: str | os.PathLike, s: SLC, inputs: tuple = ()) -> None:
 
 
 def read_slc(path: str | os.PathLike, load_image: bool = True) -> SLC:
-    """Read an SLC product; a malformed file raises :class:`ProductError` (one line)."""
+    """Read an SLC product; a malformed or implausible file raises :class:`ProductError` (one line).
+
+    Checks: a complex (n_lines, n_samples) image (finite, when loaded); zero-Doppler times and slant
+    ranges finite, strictly increasing and uniform (each step the mean step within 10 %), ranges
+    positive; the radar (:meth:`Radar.validate`), orbit and attitude; the Doppler used (1-D block
+    times and ranges, (n_blocks, n_ranges) finite centroid, rate and a positive velocity); typed
+    scalar attributes, an ISO-8601 epoch, JSON parameters.
+    """
     with open_product(path, PRODUCT_TYPE) as f:
+        where = str(path)
         sv = attr_str(f, "schema_version")
         if sv != SCHEMA_VERSION:
             raise ProductError(f"{path}: slc schema version {sv} is not supported (expected {SCHEMA_VERSION})")
         img = require(f, "image", path, shape_rank=2, dtype_kind="c")
-        t = require(f, "azimuth_time", path, shape_rank=1, dtype_kind="f")[()]
-        r = require(f, "slant_range", path, shape_rank=1, dtype_kind="f")[()]
-        if img.shape != (t.size, r.size):
+        t = read_array(f, "azimuth_time", "f", ndim=1)
+        r = read_array(f, "slant_range", "f", ndim=1)
+        if img.shape != (t.size, r.size) or t.size < 1 or r.size < 1:
             raise ProductError(f"{path}: malformed product, image {img.shape} vs axes ({t.size}, {r.size})")
-        if "radar" not in f or "doppler" not in f:
-            raise ProductError(f"{path}: malformed product, missing 'radar' or 'doppler'")
+        for name, a in (("azimuth_time", t), ("slant_range", r)):
+            ck.increasing(where, name, a)
+            if a.size > 1:
+                ck.uniform(where, name, a, float(np.mean(np.diff(a))), AXIS_RTOL)
+        if r[0] <= 0:
+            raise ProductError(f"{path}: slant_range must be positive, starts at {r[0]:g} m")
+        for name in ("radar", "doppler"):
+            if name not in f or not isinstance(f[name], h5py.Group):
+                raise ProductError(f"{path}: malformed product, missing group '{name}'")
         radar = read_radar(f["radar"], path)
+        radar.validate(where)
         dg = f["doppler"]
-        dop = DopplerUsed(*(require(dg, k, path)[()] for k in
-                            ("block_time", "range_m", "fdc_hz", "fr_hz_per_s", "velocity_mps")))
+        bt = read_array(dg, "block_time", "f", ndim=1, min_size=1)
+        rm = read_array(dg, "range_m", "f", ndim=1, min_size=1)
+        grid = (bt.size, rm.size)
+        dop = DopplerUsed(bt, rm, *(read_array(dg, k, "f", shape=grid) for k in ("fdc_hz", "fr_hz_per_s",
+                                                                                  "velocity_mps")))
+        if np.any(dop.velocity_mps <= 0):
+            raise ProductError(f"{path}: doppler/velocity_mps must be positive")
         orbit, attitude = read_platform(f, path)
+        for part in (orbit, attitude):
+            if part is not None:
+                part.validate(where)
         truth = read_mapping(f["truth"]) if "truth" in f else None
-        timings = dict(f["timings"].attrs) if "timings" in f else {}
-        params = json.loads(attr_str(f, "parameters") or "{}")
-        return SLC(
-            image=img[()] if load_image else np.zeros((t.size, 0), np.complex64),
-            azimuth_time=t, slant_range=r, epoch_utc=attr_str(f, "epoch_utc") or "", radar=radar,
-            doppler=dop, look_side=attr_str(f, "look_side", "right"), source=attr_str(f, "source", "unknown"),
-            algorithm=attr_str(f, "algorithm", "rd"),
-            azimuth_spacing_m=float(f.attrs.get("azimuth_spacing_m", np.nan)),
-            first_full_line=int(f.attrs.get("first_full_line", 0)),
-            last_full_line=int(f.attrs.get("last_full_line", t.size - 1)),
-            parameters=params, timings={k: float(v) for k, v in timings.items()},
+        timings = {}
+        if "timings" in f:
+            timings = {k: attr_number(f["timings"], k) for k in f["timings"].attrs}
+        n = t.size
+        slc = SLC(
+            image=np.zeros((n, 0), np.complex64), azimuth_time=t, slant_range=r,
+            epoch_utc=ck.utc(where, "epoch_utc", attr_str(f, "epoch_utc")), radar=radar, doppler=dop,
+            look_side=ck.text(where, "look_side", attr_str(f, "look_side", "right"), LOOK_SIDES),
+            source=attr_str(f, "source", "unknown"), algorithm=attr_str(f, "algorithm", "rd"),
+            azimuth_spacing_m=attr_number(f, "azimuth_spacing_m", float("nan"), lo=0.0, unit="m"),
+            first_full_line=attr_number(f, "first_full_line", 0, integer=True),
+            last_full_line=attr_number(f, "last_full_line", n - 1, integer=True),
+            parameters=attr_json(f, "parameters", {}), timings=timings,
             orbit=orbit, attitude=attitude, truth=truth,
         )
+        if load_image:
+            slc.image = ck.array(where, "image", img[()], "c")
+        return slc

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+from sarcli.acquire.config import parse_duration
 from sarcli.acquire.emulator import Emulator, scene_source
 from sarcli.errors import ConfigError
 from sarcli.gbsar.scene import load_scene
@@ -24,7 +25,9 @@ class Config:
     """scene: GB-SAR scene TOML the VNA measures; faults ``NAME@N[:ARG],...``; time_scale: sweep / move
     duration factor (0 = instant); switch: none | grbl | 11713a; pol: the fixed polarization without a
     switch; machine_zero_m: rail-frame position of GRBL X0 (default: the scene's first stop, else 0);
-    height_m: antenna height (default: the scene's); max_travel_mm: GRBL $130; soft_limits: $20=1."""
+    height_m: antenna height (default: the scene's); max_travel_mm: GRBL $130; soft_limits: $20=1;
+    scan_interval: the scene advances by this much per scan ("10m"; default: a static scene, see
+    :class:`sarcli.acquire.emulator.SceneClock`); truth: JSON-lines file of what each scan simulated."""
 
     scene: Path | None = None
     faults: str = ""
@@ -35,10 +38,18 @@ class Config:
     height_m: float | None = None
     max_travel_mm: float = 4000.0
     soft_limits: bool = False
+    scan_interval: str | None = None
+    truth: Path | None = None
 
     def __post_init__(self) -> None:
         if self.pol.upper() not in ("VV", "VH", "HV", "HH"):
             raise ConfigError(f"--pol {self.pol}: use VV, VH, HV or HH")
+        if (self.scan_interval is not None or self.truth is not None) and self.scene is None:
+            raise ConfigError("--scan-interval and --truth need --scene (a scene that changes with time)")
+        if self.truth is not None and self.scan_interval is None:
+            raise ConfigError("--truth needs --scan-interval (the truth of a scene changing from scan to scan)")
+        if self.scan_interval is not None and not parse_duration(self.scan_interval) > 0:
+            raise ConfigError(f"--scan-interval must be > 0, got {self.scan_interval}")
 
 
 @dataclass
@@ -64,7 +75,8 @@ def run(config: Config, provenance=None, progress: Progress | None = None,
             sc = load_scene(c.scene)
             zero = float(sc.positions_m[0]) if c.machine_zero_m is None else c.machine_zero_m
             h = float(sc.rail_heights()[0]) if c.height_m is None else c.height_m
-            source = scene_source(str(c.scene), h)
+            interval = None if c.scan_interval is None else parse_duration(c.scan_interval)
+            source = scene_source(str(c.scene), h, interval, None if c.truth is None else str(c.truth))
         settings = {130: c.max_travel_mm, 20: 1 if c.soft_limits else 0}
         done = stop or threading.Event()
         old = {}

@@ -9,6 +9,7 @@ import h5py
 import numpy as np
 import pytest
 
+from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
 from sarcli.errors import ProductError
 from sarcli.io.h5common import atomic_h5, dataset, provenance
 from sarcli.io.raw import read_raw, write_raw
@@ -17,17 +18,24 @@ from sarcli.model.gbsar import Scan
 from sarcli.model.raw import Attitude, Orbit, Radar, RawProduct
 
 
+def _orbit() -> Orbit:
+    """A Radarsat-1-like J2 orbit: 15 ECI state vectors 480 s apart."""
+    r0, v0 = kepler_to_state(Keplerian(7_167_000.0, 0.0011, np.radians(98.59), 0.7, 1.3, 2.1))
+    t = np.arange(15) * 480.0 - 3360.0
+    pos, vel = propagate_j2(r0, v0, t)
+    return Orbit(t, pos, vel, "ECI")
+
+
 def _raw(n_lines=16, n_samples=32, seed=0) -> RawProduct:
     rng = np.random.default_rng(seed)
     shape = (n_lines, n_samples)
     echo = (rng.integers(-8, 8, shape) * 2 + 1) + 1j * (rng.integers(-8, 8, shape) * 2 + 1)
-    t = np.arange(15) * 480.0 - 3360.0
     return RawProduct(
         echo=echo.astype(np.complex64), azimuth_time=np.arange(n_lines) / 1256.98,
         epoch_utc="2002-06-16T15:41:00.000000Z",
         radar=Radar(5.3e9, 0.0565646, 1256.98, 32.317e6, -0.72135e12, 41.75e-6, 6.5956e-3, 988647.46, 4),
         agc_db=np.full(n_lines, 5.0, np.float32), replica=np.ones(8, np.complex64),
-        orbit=Orbit(t, rng.normal(size=(15, 3)) * 7e6, rng.normal(size=(15, 3)) * 7e3, "ECI"),
+        orbit=_orbit(),
         attitude=Attitude(np.array([0.0, 1.0]), np.array([1e-4, 2e-4]), np.array([0.5, 0.5]), np.zeros(2)),
         truth={"scene_toml": "[scene]\n", "doppler_centroid_hz": np.zeros(n_samples)},
     )
@@ -77,7 +85,7 @@ def test_atomic_write_keeps_old_product_on_failure(tmp_path):
     before = (tmp_path / "r.h5").read_bytes()
     bad = _raw()
     bad.azimuth_time = bad.azimuth_time[::-1].copy()
-    with pytest.raises(ProductError, match="not strictly increasing"):
+    with pytest.raises(ProductError, match="azimuth_time must increase"):
         write_raw(tmp_path / "r.h5", bad)
     assert (tmp_path / "r.h5").read_bytes() == before
 
@@ -87,7 +95,7 @@ def test_atomic_write_keeps_old_product_on_failure(tmp_path):
     (lambda f: f["radar"].attrs.__delitem__("prf_hz"), "radar attribute 'prf_hz' missing"),
     (lambda f: f.attrs.__setitem__("product_type", "slc"), "is a 'slc' product, expected raw"),
     (lambda f: f.attrs.__setitem__("schema_version", "9"), "schema version 9 is not supported"),
-    (lambda f: f["orbit"].attrs.__setitem__("frame", "GALACTIC"), "orbit frame"),
+    (lambda f: f["orbit"].attrs.__setitem__("frame", "GALACTIC"), "orbit: frame must be one of ECI"),
 ])
 def test_malformed_raw_refused_in_one_line(tmp_path, damage, msg):
     path = tmp_path / "r.h5"

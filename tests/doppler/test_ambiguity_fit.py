@@ -98,3 +98,10 @@ def test_poly2d_degrades_degree_with_one_range_block():
     assert p(850e3, 1.5) == pytest.approx(2.5)
     assert p(850e3, 3.0) == pytest.approx(3.0)  # held at the domain edge, not extrapolated
     assert p(900e3, -7.0) == pytest.approx(1.0)
+
+
+def test_rounding_confidence_student_t_one_dof_is_the_cauchy_law():
+    """With one degree of freedom Student's t is the Cauchy law, CDF 1/2 + atan(t)/pi (closed form)."""
+    off, sigma = 3.2, 0.3
+    expected = (np.arctan((3.5 - off) / sigma) - np.arctan((2.5 - off) / sigma)) / np.pi
+    assert rounding_confidence(off, sigma, dof=1.0) == pytest.approx(expected, rel=1e-12)

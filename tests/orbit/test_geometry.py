@@ -95,17 +95,46 @@ def test_target_from_doppler_constraints_and_side(ecef_truth, side):
 
 def test_doppler_sign_convention_and_eci_equivalence(polar_truth):
     """f_D = -(2/lam) dR/dt (phase exp(-j4piR/lam)): check by finite differences, and ECI (seed eq. 4-5)
-    with v_rel = v - w x r gives the same Doppler as ECEF."""
+    with v_rel = v - w x r gives the same Doppler as ECEF.
+
+    Error analysis of the central differences of R(t) = |p - r(t)| (r(t) the Hermite interpolant; t0 and
+    t0 +- h lie in one interpolation window, [2880, 3360] s, so R is one smooth polynomial there):
+
+    - truncation: D1 = R' + h^2 R3/6 + ...,  D2 = R'' + h^2 R4/12 + ...  (R3, R4: third, fourth derivative)
+    - round-off: each R carries an error dR <= eps |r| (the position components, ~7.2e6 m, are Horner
+      sums of degree 19 whose terms fall off fast; FMA contraction or not changes the last bits, which is
+      why the former 1 ms step passed on one machine and failed on another), so |dD1| <= dR / h and
+      |dD2| <= 4 dR / h^2 (weights 1, 2, 1).
+
+    Minimizing h^2 |R4|/12 + 4 eps|r|/h^2 gives h2 = (48 eps|r| / |R4|)^(1/4) ~ 0.05 s (at 1 ms the
+    round-off bound alone is 1.2e-4 relative); the first difference's optimum is h1 = (3 eps|r| / |R3|)^(1/3)
+    ~ 0.01 s. R3 and R4 come from wide stencils (H = 2 s, 4 s, whose own errors are below 1e-3 relative).
+    Tolerance: twice the bound at the chosen step, ~2e-7 relative for the rate, which resolves the
+    v_r^2 / R term of the rate (~7e-6 relative here).
+    """
     sv_i = polar_truth.sv
     sv_e = sv_i.to_ecef()
     t0 = 3000.0
     r, v, a = sv_e.interpolate(t0)
     p, _ = G.target_from_look(r, v, 0.45, pitch=2e-3, yaw=-1e-3)
-    dt = 1e-3
-    R = [np.linalg.norm(p - sv_e.interpolate(t0 + k * dt)[0]) for k in (-1, 0, 1)]
-    assert G.doppler_hz(r, v, p, LAM) == pytest.approx(-2 / LAM * (R[2] - R[0]) / (2 * dt), abs=1e-3)
-    fr = -2 / LAM * (R[2] - 2 * R[1] + R[0]) / dt**2
-    assert G.doppler_rate_hz_per_s(r, v, a, p, LAM) == pytest.approx(fr, rel=1e-5)
+
+    def rng(t):
+        return np.linalg.norm(p - sv_e.interpolate(np.asarray(t, np.float64))[0], axis=-1)
+
+    d_r = np.finfo(np.float64).eps * np.linalg.norm(r)  # round-off bound of one R evaluation, m
+    r3 = abs(np.dot([-1, 2, 0, -2, 1], rng(t0 + 2.0 * np.arange(-2, 3)))) / (2 * 2.0**3)
+    r4 = abs(np.dot([1, -4, 6, -4, 1], rng(t0 + 4.0 * np.arange(-2, 3)))) / 4.0**4
+    h1 = (3 * d_r / r3) ** (1 / 3)
+    h2 = (48 * d_r / r4) ** 0.25
+    assert 1e-3 < h1 < 0.1 and 1e-2 < h2 < 0.5  # the analysis' orders of magnitude hold for this orbit
+    R = rng(t0 + h1 * np.array([-1.0, 1.0]))
+    tol1 = 2 * 2 / LAM * (r3 * h1**2 / 6 + d_r / h1)
+    assert G.doppler_hz(r, v, p, LAM) == pytest.approx(-2 / LAM * (R[1] - R[0]) / (2 * h1), abs=tol1)
+    R = rng(t0 + h2 * np.array([-1.0, 0.0, 1.0]))
+    fr = -2 / LAM * (R[2] - 2 * R[1] + R[0]) / h2**2
+    tol2 = 2 * 2 / LAM * (r4 * h2**2 / 12 + 4 * d_r / h2**2)
+    assert tol2 < 1e-6 * abs(fr)
+    assert G.doppler_rate_hz_per_s(r, v, a, p, LAM) == pytest.approx(fr, abs=tol2)
     assert G.doppler_rate_hz_per_s(r, v, a, p, LAM) < 0
     # ECI: rotate the fixed target into ECI at t0 and use the relative velocity
     ri, vi, _ = sv_i.interpolate(t0)

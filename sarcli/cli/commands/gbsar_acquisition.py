@@ -86,6 +86,10 @@ def emulate_cmd(
     height: float = typer.Option(None, "--height", help="Antenna height, m (default: the scene's)."),
     max_travel_mm: float = typer.Option(4000.0, "--max-travel-mm", help="GRBL $130 (mm)."),
     soft_limits: bool = typer.Option(False, "--soft-limits", help="$20=1: targets beyond travel raise ALARM:2."),
+    scan_interval: str = typer.Option(None, "--scan-interval", help="Simulated clock: the scene advances by "
+                                      "this much per scan (e.g. 10m); default: a static scene."),
+    truth: Path = typer.Option(None, "--truth", help="With --scan-interval: append what each scan simulated "
+                               "(JSON lines) to this file."),
     json_out: bool = typer.Option(False, "--json", help='First stdout line: {"vna_port": ..., "rail_port": ...}.'),
 ) -> None:
     """Emulate the instruments on pseudo-terminals until interrupted: a Prologix GPIB-USB adapter
@@ -98,6 +102,8 @@ def emulate_cmd(
       sarcli gbsar emulate --scene samples/gbsar_indoor.toml --switch grbl --time-scale 0
 
       sarcli gbsar emulate --json --faults garble@3,alarm@5
+
+      sarcli gbsar emulate --scene samples/gbsar_landslide.toml --time-scale 0 --scan-interval 10m --truth t.jsonl
     """
     from sarcli.workflows import gbsar_emulate as wf
 
@@ -109,7 +115,8 @@ def emulate_cmd(
              f"rail X0 = {r.machine_zero_m:g} m of the rail frame; Ctrl-C to stop")
 
     cfg = wf.Config(scene=scene, faults=faults, time_scale=time_scale, switch=switch, pol=pol,
-                    machine_zero_m=machine_zero, height_m=height, max_travel_mm=max_travel_mm, soft_limits=soft_limits)
+                    machine_zero_m=machine_zero, height_m=height, max_travel_mm=max_travel_mm, soft_limits=soft_limits,
+                    scan_interval=scan_interval, truth=truth)
     run_workflow(wf, cfg, False, on_ready=ready)
 
 

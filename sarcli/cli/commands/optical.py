@@ -8,7 +8,7 @@ import typer
 
 from sarcli.cli.common import info, make_typer, print_report, run_workflow
 
-optical_app = make_typer(help="Emulated acousto-optic / CCD real-time processor (seed 004).")
+optical_app = make_typer(help="Emulated acousto-optic / CCD real-time processor [KimAODCCD].")
 
 
 @optical_app.command("compare")
