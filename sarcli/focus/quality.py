@@ -21,6 +21,7 @@ The peak phase is that of the original (not demodulated) image at the interpolat
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,12 +181,17 @@ def truth_targets(truth: dict | None) -> list[tuple[float, float]]:
     if truth is None or "targets" not in truth:
         return []
     t = truth["targets"]
-    names = t.dtype.names or ()
+    names = getattr(getattr(t, "dtype", None), "names", None) or ()
+    if getattr(t, "ndim", 0) != 1:
+        raise ProductError("the product's truth table of targets is not a table (one row per target)")
     tk = next((k for k in ("zero_doppler_time_s", "zero_doppler_time") if k in names), None)
     rk = next((k for k in ("closest_range_m", "slant_range_m") if k in names), None)
     if tk is None or rk is None:
         return []
-    return [(float(a), float(b)) for a, b in zip(t[tk], t[rk], strict=True)]
+    out = [(float(a), float(b)) for a, b in zip(t[tk], t[rk], strict=True)]
+    if not all(math.isfinite(a) and math.isfinite(b) for a, b in out):
+        raise ProductError("the product's truth table of targets holds non-finite positions")
+    return out
 
 
 def azimuth_ground_spacing(slc) -> float:
