@@ -96,15 +96,17 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
-                        terrain: Terrain | None = None) -> None:
-    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m)."""
+                        terrain: Terrain | None = None, intensity: np.ndarray | None = None) -> None:
+    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m).
+    ``intensity``: ``multilook(slc.image, looks_az, looks_rg)`` when the caller has it (then ``slc``
+    needs no image)."""
     import warnings
 
     from rasterio.errors import NotGeoreferencedWarning
 
     from sarcli.io.images import write_geotiff
 
-    inten = multilook(slc.image, looks_az, looks_rg)
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg, terrain or ConstantHeight(0.0))
     with warnings.catch_warnings():
         # the GCPs are attached after the file is opened: rasterio warns in between
@@ -114,17 +116,18 @@ def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ta
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = 512):
+                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = 512,
+                intensity: np.ndarray | None = None):
     """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection,
     pixels placed on ``terrain`` (default 0 m). With a DEM the coarse grid is made denser (``coarse``
     at least 65): the inverse map is linear per triangle, and the terrain bends it on the scale of
-    the hills."""
+    the hills. ``intensity``: as in :func:`write_slant_geotiff`."""
     from pyproj import Transformer
     from rasterio.transform import Affine
     from scipy.interpolate import LinearNDInterpolator
     from scipy.ndimage import map_coordinates
 
-    inten = multilook(slc.image, looks_az, looks_rg)
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     n, m = inten.shape
     t, r = _look_axes(slc, looks_az, looks_rg, inten.shape)
     rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
@@ -172,11 +175,13 @@ def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None 
 
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None) -> str:
-    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used."""
+                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None,
+                      intensity: np.ndarray | None = None) -> str:
+    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used.
+    ``intensity``: as in :func:`write_slant_geotiff`."""
     from sarcli.io.images import write_geotiff
 
-    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m, terrain)
+    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m, terrain, intensity=intensity)
     write_geotiff(path, amp, crs, transform=transform, tags=tags,
                   band_description="amplitude, map projected (bilinear intensity resampling)")
     return crs
