@@ -29,6 +29,8 @@ from sarcli.threads import limited, usable_cores
 log = logging.getLogger(__name__)
 
 SCHEDULER_ENV = "SARCLI_SCHEDULER"
+#: configuration fields that say where the work runs, not what it computes (products do not store them)
+EXECUTION_FIELDS = ("workers", "threads_per_worker", "scheduler")
 _ADDRESS = re.compile(r"^(tcp|tls)://[A-Za-z0-9_.\-\[\]:]+:\d+$")
 #: seconds to wait for a scheduler that does not answer
 CONNECT_TIMEOUT_S = 20

@@ -69,7 +69,7 @@ def focus_blocks(client: Any, focuser: Any, plan: Any, raw_path: str | os.PathLi
                              key=f"focus-block-{b}-{os.urandom(8).hex()}")
 
     n = plan.n_blocks
-    pending = as_completed([submit(b) for b in range(min(ahead, n))])
+    pending = as_completed([submit(b) for b in range(min(ahead, n))], loop=client.loop)
     submitted, done = min(ahead, n), 0
     timings = getattr(plan, "timings", None)
     try:

@@ -13,13 +13,16 @@ arguments: the scheduler runs every task as soon as its inputs exist, anywhere) 
 - ``skipped``: a task it depends on did not succeed; it never ran.
 
 One failure never stops the other tasks. Progress: ``progress("tasks", done, total)`` as tasks finish.
+The warnings a task raises are kept in its outcome (one line each), not printed by the worker.
 Without a client the same tasks run in order in this process (same functions, same results).
 """
 
 from __future__ import annotations
 
+import logging
 import time
 import uuid
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -52,6 +55,7 @@ class Outcome:
     error: str = ""
     seconds: float = 0.0
     worker: str = ""
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,10 @@ class _Result:
     error: str = ""
     seconds: float = 0.0
     worker: str = ""
+    warnings: tuple[str, ...] = ()
+
+    def outcome(self, key: str) -> Outcome:
+        return Outcome(key, self.status, self.value, self.error, self.seconds, self.worker, self.warnings)
 
 
 def one_line(e: BaseException) -> str:
@@ -93,13 +101,30 @@ def _run(fn: Callable[..., Any], threads_by_host: Mapping[str, int], n_args: int
     for key, up in zip(keys, upstream, strict=True):
         if up.status != "done":
             return _Result("skipped", error=f"{key} {up.status}")
+    if _worker_address():
+        _quiet_logging()
     t0 = time.perf_counter()
-    try:
-        with task_threads(threads_by_host):
-            value = fn(*own, *(up.value for up in upstream))
-    except (SarcliError, OrbitError) as e:
-        return _Result("failed", error=one_line(e), seconds=time.perf_counter() - t0, worker=_worker_address())
-    return _Result("done", value, seconds=time.perf_counter() - t0, worker=_worker_address())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            with task_threads(threads_by_host):
+                value = fn(*own, *(up.value for up in upstream))
+        except (SarcliError, OrbitError) as e:
+            return _Result("failed", error=one_line(e), seconds=time.perf_counter() - t0, worker=_worker_address(),
+                           warnings=_lines(caught))
+    return _Result("done", value, seconds=time.perf_counter() - t0, worker=_worker_address(), warnings=_lines(caught))
+
+
+def _quiet_logging() -> None:
+    """On a worker, sarcli's log records go nowhere (Python's last-resort handler would print its warnings
+    on the worker's stderr): what a person needs is in the task's outcome."""
+    lg = logging.getLogger("sarcli")
+    if not lg.handlers:
+        lg.addHandler(logging.NullHandler())
+
+
+def _lines(caught: list[warnings.WarningMessage]) -> tuple[str, ...]:
+    return tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
 
 
 def _check(tasks: Sequence[Task]) -> None:
@@ -133,7 +158,7 @@ def run_tasks(tasks: Sequence[Task], client: Any = None, progress: Progress | No
                                        pure=False)
     done = 0
     try:
-        for _ in as_completed(futures.values()):
+        for _ in as_completed(futures.values(), loop=client.loop):
             done += 1
             progress("tasks", done, len(tasks))
     except BaseException:
@@ -143,8 +168,7 @@ def run_tasks(tasks: Sequence[Task], client: Any = None, progress: Progress | No
     for t in tasks:
         f = futures[t.key]
         if f.status == "finished":
-            r = f.result()
-            out[t.key] = Outcome(t.key, r.status, r.value, r.error, r.seconds, r.worker)
+            out[t.key] = f.result().outcome(t.key)
             continue
         bad = [d for d in t.deps if out[d].status != "done"]
         if bad:
@@ -167,4 +191,4 @@ def _run_here(tasks: Sequence[Task], progress: Progress, retries: int) -> dict[s
                 if attempt == retries:
                     results[t.key] = _Result("failed", error=one_line(e))
         progress("tasks", i + 1, len(tasks))
-    return {k: Outcome(k, r.status, r.value, r.error, r.seconds, r.worker) for k, r in results.items()}
+    return {k: r.outcome(k) for k, r in results.items()}

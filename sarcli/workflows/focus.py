@@ -116,11 +116,9 @@ class Config:
 
     def stored(self) -> dict[str, Any]:
         """The configuration recorded in the product (``parameters["config"]``): everything but where it ran."""
+        from sarcli.parallel.cluster import EXECUTION_FIELDS
+
         return {k: v for k, v in to_mapping(self).items() if k not in EXECUTION_FIELDS}
-
-
-#: Config fields that say where the work runs, not what it computes (not stored in products)
-EXECUTION_FIELDS = ("workers", "threads_per_worker", "scheduler")
 
 
 @dataclass
