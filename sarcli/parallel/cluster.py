@@ -73,7 +73,8 @@ def cluster_spec(scheduler: str | None, workers: int | None, threads_per_worker:
     env = os.environ.get(SCHEDULER_ENV, "").strip()
     if scheduler is None and workers is None and use_env and env:
         scheduler = env
-    return ClusterSpec(scheduler=scheduler, workers=workers, threads_per_worker=threads_per_worker or 1)
+    return ClusterSpec(scheduler=scheduler, workers=workers,
+                       threads_per_worker=1 if threads_per_worker is None else threads_per_worker)
 
 
 @contextlib.contextmanager

@@ -76,6 +76,9 @@ class Config:
         own = sorted(set(self.focus) & set(_FOCUS_OWN))
         if own:
             raise ConfigError(f"focus options {', '.join(own)} are set by the batch for every scene")
+        from sarcli.workflows import focus
+
+        from_mapping(focus.Config, {**self.focus, "raw": "raw.h5", "output": "slc.h5"}, "--focus")
 
     def cluster(self):
         """The :class:`sarcli.parallel.cluster.ClusterSpec`, or None (``workers = 0``: this process)."""
