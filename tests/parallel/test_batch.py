@@ -115,3 +115,27 @@ def test_folders_are_checked_before_any_work(cli, tmp_path):
     assert r.exit_code == 2 and "is the input folder" in r.stderr
     r = cli("batch", tmp_path / "in", "-o", tmp_path / "out", "--workers", "0")
     assert r.exit_code == 2 and "no raw products or sensor inputs" in r.stderr
+
+
+def test_batch_is_a_workflow_with_a_toml_table():
+    import tomllib
+
+    from sarcli.config import from_mapping
+    from sarcli.workflows import WORKFLOWS
+
+    doc = tomllib.loads('[batch]\ninput = "scenes"\noutput = "products"\nworkers = 2\n'
+                        '[batch.focus]\nlooks_az = 4\noptions = { block_lines = 2048 }\n')
+    cfg = from_mapping(WORKFLOWS.get("batch").Config, doc["batch"], "batch")
+    assert cfg.workers == 2 and cfg.focus == {"looks_az": 4, "options": {"block_lines": 2048}}
+    assert cfg.cluster().describe() == "local cluster of 2 process(es) x 1 thread(s)"
+
+
+def test_the_batch_command_module_loads_no_heavy_package():
+    """`sarcli batch --help` stays fast: the command imports neither Dask nor arrays nor files libraries."""
+    import subprocess
+    import sys
+
+    code = ("import sys, sarcli.cli.commands.batch; print(sorted(set(m.split('.')[0] for m in sys.modules) & "
+            "{'numpy', 'h5py', 'scipy', 'numba', 'rasterio', 'matplotlib', 'dask', 'distributed'}))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip() == "[]", r.stdout
