@@ -292,7 +292,7 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
         def write(first, block):
             out[first:first + block.shape[0]] = block
 
-        sink = BlockSink(write, plan.output_shape, tuple(looks))
+        sink = BlockSink(write, plan.output_shape, tuple(looks), str(Path(config.output).resolve().parent))
 
         def on_block(done, total):
             progress("focusing", done, total)

@@ -98,3 +98,18 @@ def test_slc_chunks_are_whole_lines_and_inputs_are_hashed(raw, tmp_path):
         inputs = json.loads(f.attrs["inputs"])
     assert inputs == [{"path": "raw.h5", "sha256": hashlib.sha256(raw.read_bytes()).hexdigest()}]
     assert image_chunks((6354 * 0 + 23000, 6354)) == (20, 6354)  # 6354-sample lines: 20 lines of 50.8 kB
+
+
+def test_a_geotiff_written_in_strips_is_the_file_written_whole(tmp_path):
+    from rasterio.transform import Affine
+
+    from sarcli.io.images import Strips, write_geotiff
+
+    rng = np.random.default_rng(2)
+    a = rng.standard_normal((1300, 700)).astype(np.float32)
+    a[rng.random(a.shape) < 0.05] = np.nan
+    t = Affine(10.0, 0.0, 500000.0, 0.0, -10.0, 5400000.0)
+    write_geotiff(tmp_path / "whole.tif", a, "EPSG:32610", transform=t, tags={"k": "v"})
+    strips = Strips(a.shape, lambda: ((r, a[r:r + 512]) for r in range(0, a.shape[0], 512)))
+    write_geotiff(tmp_path / "strips.tif", strips, "EPSG:32610", transform=t, tags={"k": "v"})
+    assert (tmp_path / "whole.tif").read_bytes() == (tmp_path / "strips.tif").read_bytes()

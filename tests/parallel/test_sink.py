@@ -79,3 +79,18 @@ def test_statistics_of_a_zero_image_are_empty():
     sink = BlockSink(lambda a, b: None, (8, 8))
     sink(0, np.zeros((8, 8), np.complex64))
     assert sink.statistics(0, 7) == {}
+
+
+def test_a_large_intensity_waits_in_an_anonymous_file(tmp_path, monkeypatch):
+    """Spilled while the blocks arrive (no file left in the folder), read back whole: the same cells."""
+    import sarcli.focus.sink as sink_mod
+
+    monkeypatch.setattr(sink_mod, "SPILL_BYTES", 1000)
+    img = _image(203, 61, 5)
+    acc = LookAccumulator(img.shape, 2, 3, str(tmp_path))
+    assert acc.out is None and acc._file is not None
+    for a, b in [(100, 203), (0, 37), (37, 100)]:
+        acc.add(a, img[a:b])
+    assert list(tmp_path.iterdir()) == []
+    np.testing.assert_array_equal(acc.result(), multilook(img, 2, 3))
+    np.testing.assert_array_equal(acc.result(), multilook(img, 2, 3))  # read back once, kept
