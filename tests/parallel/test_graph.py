@@ -67,12 +67,26 @@ def test_graph_here(tmp_path):
     assert seen[-1] == ("tasks", 8, 8)
 
 
+def thread_budget(*up):
+    import numba
+
+    from sarcli.threads import budget
+
+    return budget(), numba.get_num_threads()
+
+
 def test_graph_on_a_dask_cluster(tmp_path):
+    """Same outcomes; each task's thread budget is its share of the host: cores // (2 workers x 1 thread)."""
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
-            Client(cluster, set_as_default=False) as client:
-        _check(run_tasks(_graph(tmp_path), client), tmp_path)
+    from sarcli.threads import usable_cores
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, protocol="tcp",
+                      dashboard_address=None) as cluster, Client(cluster, set_as_default=False) as client:
+        out = run_tasks([*_graph(tmp_path), Task("budget", thread_budget)], client)
+    _check(out, tmp_path)
+    share = max(1, usable_cores() // 2)
+    assert out["budget"].value == (share, share)
 
 
 def test_a_graph_in_the_wrong_order_is_refused():
