@@ -27,6 +27,7 @@ def scenes(tmp_path_factory):
     return inp
 
 
+@pytest.mark.slow
 def test_batch_here(cli, scenes, tmp_path):
     inp = tmp_path / "in"
     shutil.copytree(scenes, inp)

@@ -104,8 +104,10 @@ def test_batch_on_a_cluster_survives_a_killed_worker(cluster, tmp_path):
     out = tmp_path / "out"
     env = dict(os.environ, SARCLI_NO_PROGRESS="1")
     t0 = time.monotonic()
-    batch = subprocess.Popen([str(BIN / "sarcli"), "batch", str(inp), "-o", str(out), "--scheduler", address, "--json"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    report = tmp_path / "dask-report.html"
+    batch = subprocess.Popen([str(BIN / "sarcli"), "batch", str(inp), "-o", str(out), "--scheduler", address, "--json",
+                              "--report", str(report)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             env=env)
     try:
         # kill a worker once the first product exists: the graph (7 tasks) is still running
         while not (out.is_dir() and any(p.suffix == ".h5" and not p.name.startswith(".") for p in out.iterdir())):
@@ -121,7 +123,8 @@ def test_batch_on_a_cluster_survives_a_killed_worker(cluster, tmp_path):
     assert batch.returncode == 0, stderr
     rep = json.loads(stdout)
     assert rep["counts"] == {"done": 7, "failed": 0, "skipped": 0, "up_to_date": 0}
-    assert rep["where"] == f"scheduler {address}"
+    assert rep["where"] == f"scheduler {address}" and rep["performance_report"] == str(report)
+    assert "Dask Performance Report" in report.read_text()
     done_by = {s["worker"] for n in "abc" for s in json.loads((out / f"{n}.json").read_text())["steps"]}
     assert names["w0"] in done_by and done_by <= set(names.values())  # the survivor finished the graph
     for n in "abc":

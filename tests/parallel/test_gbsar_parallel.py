@@ -63,6 +63,7 @@ def _check(ex, images):
     np.testing.assert_array_equal(got, stack[:, 4 + r, c].T)
 
 
+@pytest.mark.slow
 def test_coherence_graph_here_equals_the_whole_stack(images):
     _check(Here(), images)
 
