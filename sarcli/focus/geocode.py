@@ -13,7 +13,8 @@ too far from the track on the ground (a 1 km hill at Radarsat-1's incidence of a
   (x, y) -> (line, column) is linear over its Delaunay triangles (the map is smooth: the error of the
   linear pieces is below 0.01 pixel for a Radarsat-1 swath), and the intensity is resampled
   bilinearly (sqrt after resampling), NaN outside the image. Pixel spacing: the larger of the ground
-  range and azimuth spacings of the looks (no aliasing) unless given. Written in row strips.
+  range and azimuth spacings of the looks (no aliasing) unless given. Computed and written in row
+  strips (the map raster of a full scene is never held whole).
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ import numpy as np
 from sarcli.errors import SarcliError
 from sarcli.model.slc import SLC
 from sarcli.model.terrain import ConstantHeight, Terrain
+
+#: rows of the GeoTIFFs computed and written at a time (a multiple of their 256-row tiles)
+STRIP = 512
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
@@ -96,35 +100,53 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
-                        terrain: Terrain | None = None) -> None:
-    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m)."""
+                        terrain: Terrain | None = None, intensity: np.ndarray | None = None) -> None:
+    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m).
+    ``intensity``: ``multilook(slc.image, looks_az, looks_rg)`` when the caller has it (then ``slc``
+    needs no image)."""
     import warnings
 
     from rasterio.errors import NotGeoreferencedWarning
 
-    from sarcli.io.images import write_geotiff
+    from sarcli.io.images import Strips, write_geotiff
 
-    inten = multilook(slc.image, looks_az, looks_rg)
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg, terrain or ConstantHeight(0.0))
+    amp = Strips(inten.shape, lambda: ((a, np.sqrt(inten[a:a + STRIP])) for a in range(0, inten.shape[0], STRIP)))
     with warnings.catch_warnings():
         # the GCPs are attached after the file is opened: rasterio warns in between
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
-        write_geotiff(path, np.sqrt(inten), 4326, gcps=gcps, tags=tags,
+        write_geotiff(path, amp, 4326, gcps=gcps, tags=tags,
                       band_description="amplitude, slant-range geometry (lines: zero-Doppler time)")
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = 512):
+                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = STRIP,
+                intensity: np.ndarray | None = None):
     """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection,
     pixels placed on ``terrain`` (default 0 m). With a DEM the coarse grid is made denser (``coarse``
     at least 65): the inverse map is linear per triangle, and the terrain bends it on the scale of
-    the hills."""
+    the hills. ``intensity``: as in :func:`write_slant_geotiff`."""
+    strips, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, coarse, strip, intensity)
+    out = np.empty(strips.shape, np.float32)
+    for a, rows in strips:
+        out[a:a + rows.shape[0]] = rows
+    return out, transform, crs
+
+
+def map_strips(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
+               spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = STRIP,
+               intensity: np.ndarray | None = None):
+    """:func:`map_project` as (:class:`sarcli.io.images.Strips` of ``strip`` map rows, transform, CRS): the
+    map raster is computed strip by strip as it is written, never held whole."""
     from pyproj import Transformer
     from rasterio.transform import Affine
     from scipy.interpolate import LinearNDInterpolator
     from scipy.ndimage import map_coordinates
 
-    inten = multilook(slc.image, looks_az, looks_rg)
+    from sarcli.io.images import Strips
+
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     n, m = inten.shape
     t, r = _look_axes(slc, looks_az, looks_rg, inten.shape)
     rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
@@ -154,29 +176,33 @@ def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None 
         raise SarcliError(f"map raster {ny} x {nx} is too large: increase the pixel spacing or the looks")
     rr, cc = np.meshgrid(rows.astype(float), cols.astype(float), indexing="ij")
     inv = LinearNDInterpolator(np.column_stack([x.ravel(), y.ravel()]), np.column_stack([rr.ravel(), cc.ravel()]))
-    out = np.full((ny, nx), np.nan, np.float32)
     xs = x0 + np.arange(nx) * spacing_m
-    for a in range(0, ny, strip):
-        b = min(ny, a + strip)
-        ys = y1 - np.arange(a, b) * spacing_m
-        gx, gy = np.meshgrid(xs, ys)
-        rc = inv(gx.ravel(), gy.ravel())
-        ok = np.all(np.isfinite(rc), axis=1)
-        vals = np.full(gx.size, np.nan, np.float32)
-        if np.any(ok):
-            vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
-        out[a:b] = np.sqrt(vals).reshape(gx.shape)
+
+    def strips():
+        for a in range(0, ny, strip):
+            b = min(ny, a + strip)
+            ys = y1 - np.arange(a, b) * spacing_m
+            gx, gy = np.meshgrid(xs, ys)
+            rc = inv(gx.ravel(), gy.ravel())
+            ok = np.all(np.isfinite(rc), axis=1)
+            vals = np.full(gx.size, np.nan, np.float32)
+            if np.any(ok):
+                vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
+            yield a, np.sqrt(vals).reshape(gx.shape)
+
     # pixel (i, j) centre at (x0 + j s, y1 - i s): the raster's corner is half a pixel up-left of it
     transform = Affine(spacing_m, 0.0, x0 - 0.5 * spacing_m, 0.0, -spacing_m, y1 + 0.5 * spacing_m)
-    return out, transform, crs
+    return Strips((ny, nx), strips), transform, crs
 
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None) -> str:
-    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used."""
+                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None,
+                      intensity: np.ndarray | None = None) -> str:
+    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used.
+    ``intensity``: as in :func:`write_slant_geotiff`."""
     from sarcli.io.images import write_geotiff
 
-    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m, terrain)
+    amp, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, intensity=intensity)
     write_geotiff(path, amp, crs, transform=transform, tags=tags,
                   band_description="amplitude, map projected (bilinear intensity resampling)")
     return crs

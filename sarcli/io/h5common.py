@@ -18,7 +18,9 @@ import datetime as _dt
 import hashlib
 import json
 import os
-from collections.abc import Iterator, Mapping, Sequence
+import threading
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -52,22 +54,38 @@ def created_utc() -> str:
     return t.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
 
 
-def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22) -> str:
-    """Hex SHA-256 of a file's bytes."""
+def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22, stop: threading.Event | None = None) -> str:
+    """Hex SHA-256 of a file's bytes (``stop`` set: abandoned, returns "")."""
     h = hashlib.sha256()
     with open(path, "rb") as f:
         while block := f.read(chunk):
+            if stop is not None and stop.is_set():
+                return ""
             h.update(block)
     return h.hexdigest()
 
 
-def describe_inputs(paths: Sequence[str | os.PathLike]) -> list[dict[str, str]]:
+def describe_inputs(paths: Sequence[str | os.PathLike], stop: threading.Event | None = None) -> list[dict[str, str]]:
     """Provenance entries ``{"path", "sha256"}`` for input files (file name only, for portability)."""
     out = []
     for p in paths:
         p = Path(p)
-        out.append({"path": p.name, "sha256": sha256_file(p) if p.is_file() else ""})
+        out.append({"path": p.name, "sha256": sha256_file(p, stop=stop) if p.is_file() else ""})
     return out
+
+
+@contextlib.contextmanager
+def hashing(paths: Sequence[str | os.PathLike]) -> Iterator[Callable[[], list[dict[str, str]]]]:
+    """:func:`describe_inputs` computed on a thread while the caller works (a product's inputs are read
+    once more by the hash, overlapped with the processing instead of before it); yields the function
+    that waits for the entries. Leaving the block early abandons the hash."""
+    stop = threading.Event()
+    with ThreadPoolExecutor(1, thread_name_prefix="sarcli-sha256") as pool:
+        future = pool.submit(describe_inputs, list(paths), stop)
+        try:
+            yield future.result
+        finally:
+            stop.set()
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -110,18 +128,19 @@ def atomic_h5(
     """Open a new product for writing; it appears at ``path`` only if the block completes.
 
     Yields an ``h5py.File``. Use :func:`dataset` to create datasets so that they are
-    reproducible (no timestamps) and carry units.
+    reproducible (no timestamps) and carry units. The inputs are hashed on a thread meanwhile
+    (:func:`hashing`); their entries are written when the block completes.
     """
-    with atomic_path(path, ".tmp") as tmp:
+    with atomic_path(path, ".tmp") as tmp, hashing(inputs) as described:
         with h5py.File(tmp, "w", libver=("earliest", "v110"), track_order=False) as f:
             f.attrs["product_type"] = product_type
             f.attrs["schema_version"] = schema_version
             f.attrs["software_version"] = __version__
             f.attrs["created_utc"] = created_utc()
             f.attrs["command_line"] = command_line if command_line is not None else current().command_line
-            f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
+            f.attrs["inputs"] = json.dumps(described())
     _probed.add(_version_key(path))  # written here and now: reading it back needs no probe
 
 

@@ -6,7 +6,8 @@ GeoTIFFs are written atomically (temporary file in the target folder, then renam
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -14,10 +15,26 @@ import numpy as np
 from sarcli.errors import ProductError
 from sarcli.io.atomic import atomic_path  # re-exported: plots and CSV writers import it from here
 
+#: GDAL's block cache while a GeoTIFF is written, MB (its default, 5 % of the machine's memory, would hold
+#: a large raster's blocks a second time)
+GDAL_CACHE_MB = 64
+
+
+@dataclass(frozen=True)
+class Strips:
+    """A raster too large to hold twice, given as ``shape`` and ``strips()``: an iterator of (first row,
+    rows) covering the rows in order (rows in multiples of 256, the GeoTIFF's tile height, but the last)."""
+
+    shape: tuple[int, int]
+    strips: Any
+
+    def __iter__(self) -> Iterator[tuple[int, np.ndarray]]:
+        return iter(self.strips())
+
 
 def write_geotiff(
     path: str | os.PathLike,
-    array: np.ndarray,
+    array: np.ndarray | Strips,
     crs: str | int,
     transform: Any | None = None,
     gcps: Sequence[tuple[float, float, float, float, float]] | None = None,
@@ -31,13 +48,15 @@ def write_geotiff(
     Georeferencing is either an affine ``transform`` (rasterio.Affine) in ``crs``, or ground control
     points ``gcps`` given as (row, col, x, y, z) in ``crs`` (e.g. EPSG:4326 lon/lat for slant-range
     geometry images). ``crs`` is anything rasterio accepts ("EPSG:32610", 4326, a WKT string).
+    ``array`` may be :class:`Strips`, written strip by strip (the same file).
     """
     import rasterio
     from rasterio.control import GroundControlPoint
     from rasterio.crs import CRS
+    from rasterio.windows import Window
 
-    a = np.asarray(array, dtype=np.float32)
-    if a.ndim != 2:
+    a = array if isinstance(array, Strips) else np.asarray(array, dtype=np.float32)
+    if len(a.shape) != 2:
         raise ProductError(f"GeoTIFF needs a 2-D array, got shape {a.shape}")
     crs_obj = CRS.from_epsg(crs) if isinstance(crs, int) else CRS.from_user_input(crs)
     profile: dict[str, Any] = {
@@ -52,9 +71,13 @@ def write_geotiff(
     if transform is not None:
         profile["crs"] = crs_obj
         profile["transform"] = transform
-    with atomic_path(path, ".tif") as tmp:
+    with atomic_path(path, ".tif") as tmp, rasterio.Env(GDAL_CACHEMAX=GDAL_CACHE_MB):
         with rasterio.open(tmp, "w", **profile) as dst:
-            dst.write(a, 1)
+            if isinstance(a, Strips):
+                for row, strip in a:
+                    dst.write(np.asarray(strip, np.float32), 1, window=Window(0, row, a.shape[1], strip.shape[0]))
+            else:
+                dst.write(a, 1)
             if gcps is not None:
                 dst.gcps = ([GroundControlPoint(row=r, col=c, x=x, y=y, z=z) for r, c, x, y, z in gcps],
                             crs_obj)
