@@ -141,7 +141,8 @@ def atomic_h5(
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             yield f
             f.attrs["inputs"] = json.dumps(described())
-    _probed.add(_version_key(path))  # written here and now: reading it back needs no probe
+        _probed.add(_version_key(tmp))  # written here and now: reading it back needs no probe (a rename
+        # keeps the device, inode, size and modification time the key is made of)
 
 
 def dataset(

@@ -186,6 +186,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     """Focus ``config.raw`` into ``config.output`` (and the optional images); see the module docstring."""
     from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, options_for, run_blocks
+    from sarcli.io.atomic import all_or_nothing
 
     progress = progress or no_progress
     with using(provenance):
@@ -216,19 +217,20 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         if model is not None and config.fdc is None:
             _refuse_unresolved(model, config)
         t_doppler = time.perf_counter() - t0
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with all_or_nothing():  # the SLC, GeoTIFFs and quicklook appear together or not at all
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                t0 = time.perf_counter()
+                slc, sink = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo,
+                                           make_plan, run_blocks, progress)
+                t_focus = time.perf_counter() - t0
+            msgs = [str(w.message) for w in caught]
+            for m in msgs:
+                log.warning(m)
             t0 = time.perf_counter()
-            slc, sink = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo, make_plan,
-                                       run_blocks, progress)
-            t_focus = time.perf_counter() - t0
-        msgs = [str(w.message) for w in caught]
-        for m in msgs:
-            log.warning(m)
-        t0 = time.perf_counter()
-        stats = sink.statistics(slc.first_full_line, slc.last_full_line)
-        products = _products(config, slc, sink, terrain, how)
-        t_products = time.perf_counter() - t0
+            stats = sink.statistics(slc.first_full_line, slc.last_full_line)
+            products = _products(config, slc, sink, terrain, how)
+            t_products = time.perf_counter() - t0
         d = slc.doppler
         import numpy as np
 
@@ -267,6 +269,7 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
     from sarcli.focus.sink import BlockSink
     from sarcli.io.h5common import open_product
     from sarcli.io.slc import slc_writer
+    from sarcli.model import checks as ck
     from sarcli.model.slc import SLC
 
     ch = config.channel
@@ -307,8 +310,8 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
             with open_product(config.raw, "raw") as f:
                 ds = f["echo"] if ch == 0 else f["echo_channels"]
 
-                def read(a, b):
-                    return ds[a:b] if ch == 0 else ds[ch - 1, a:b]
+                def read(a, b):  # the samples of every block checked as they stream in (NaN, inf)
+                    return ck.array(str(config.raw), "echo", ds[a:b] if ch == 0 else ds[ch - 1, a:b], "c")
 
                 slc = run_blocks(focuser, plan, read, sink, on_block)
         else:

@@ -109,8 +109,10 @@ def _is_product(path: Path) -> bool:
     try:
         with h5py.File(path, "r") as f:
             return "product_type" in f.attrs
-    except OSError:
+    except OSError:  # not HDF5 at all
         return False
+    except Exception:  # an HDF5 file the library chokes on: open_product gives the one-line reason
+        return True
 
 
 def _is_rslc(path: Path) -> bool:
