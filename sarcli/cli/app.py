@@ -22,6 +22,8 @@ from sarcli.cli.common import SarcliGroup, make_typer, terminal
 #: command -> (modules of sarcli.cli.commands that register it, the first paragraph of its help), in the
 #: order of ``sarcli --help`` (commands, then command groups)
 COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
+    "batch": (("batch",), "Process a folder of scenes: raw -> Doppler -> SLC + GeoTIFF + quicklook, as one "
+                          "task graph."),
     "design": (("design",), "Derive resolutions, PRF window, Doppler samples and swath, and check each "
                             "constraint."),
     "doppler": (("doppler",), "Estimate the Doppler centroid (baseband CDE + ambiguity) and the Doppler rate."),

@@ -20,14 +20,24 @@ from sarcli.focus.geocode import multilook
 from sarcli.model.slc import SLC
 
 
+def quicklook_looks(shape: tuple[int, int], looks_az: int = 1, looks_rg: int = 1,
+                    max_pixels: int = 1600) -> tuple[int, int, int]:
+    """(looks in azimuth, looks in range, extra factor) of the quicklook of an image of ``shape``: the
+    looks asked for times the factor that fits ``max_pixels`` on the longer side."""
+    n, m = shape
+    f = max(1, math.ceil(max(n / looks_az, m / looks_rg) / max_pixels))
+    return looks_az * f, looks_rg * f, f
+
+
 def write_slc_quicklook(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, max_pixels: int = 1600,
-                        title: str | None = None) -> None:
+                        title: str | None = None, intensity: np.ndarray | None = None) -> None:
+    """``intensity``: ``multilook(slc.image, *quicklook_looks(...)[:2])`` when the caller has it (then
+    ``slc`` needs no image)."""
     from sarcli.io.images import write_quicklook
 
-    n, m = slc.image.shape
-    f = max(1, math.ceil(max(n / looks_az, m / looks_rg) / max_pixels))
-    la, lr = looks_az * f, looks_rg * f
-    inten = multilook(slc.image, la, lr)
+    n, m = slc.azimuth_time.size, slc.slant_range.size
+    la, lr, f = quicklook_looks((n, m), looks_az, looks_rg, max_pixels)
+    inten = multilook(slc.image, la, lr) if intensity is None else intensity
     t = slc.azimuth_time
     r = slc.slant_range / 1e3
     extent = (r[0], r[min(m, inten.shape[1] * lr) - 1], t[min(n, inten.shape[0] * la) - 1], t[0])

@@ -28,24 +28,29 @@ from __future__ import annotations
 import json
 import os
 
+import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     atomic_h5,
+    attr_json,
+    attr_number,
     attr_str,
     coordinate,
     dataset,
     group,
     open_product,
     provenance,
-    require,
+    read_array,
     to_jsonable,
     units_from_name,
 )
+from sarcli.model.constants import C_LIGHT
 from sarcli.model.doppler import PolyDoppler
 from sarcli.model.doppler_summary import DopplerSummary
 from sarcli.model.poly import Poly2D
+from sarcli.model.raw import CARRIER_HZ, PRF_HZ
 
 PRODUCT_TYPE = "doppler"
 SCHEMA_VERSION = "1"
@@ -79,15 +84,17 @@ def _write_poly(f, name: str, p: Poly2D, units: str) -> None:
 
 
 def _read_poly(f, name: str, path) -> Poly2D:
-    if name not in f:
-        raise ProductError(f"{path}: malformed doppler product, missing '{name}'")
+    """A polynomial group: finite 2-D coefficients, finite offsets, positive finite scales (they divide),
+    an integer range power."""
+    if name not in f or not isinstance(f[name], h5py.Group):
+        raise ProductError(f"{path}: malformed doppler product, missing group '{name}'")
     g = f[name]
-    coef = require(g, "coef", path, shape_rank=2)[()]
-    try:
-        x0, xs, y0, ys = (float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys"))
-        return Poly2D(coef, x0, xs, y0, ys, int(g.attrs.get("x_power", 0)))
-    except KeyError as e:
-        raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
+    coef = read_array(g, "coef", "f", ndim=2, min_size=1)
+    x0, y0 = (attr_number(g, k) for k in ("x0", "y0"))
+    xs, ys = (attr_number(g, k, lo=0.0) for k in ("xs", "ys"))
+    if xs == 0.0 or ys == 0.0:
+        raise ProductError(f"{path}: malformed doppler product, '{name}' has a zero scale")
+    return Poly2D(coef, x0, xs, y0, ys, attr_number(g, "x_power", 0, lo=-4, hi=4, integer=True))
 
 
 def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = (),
@@ -129,20 +136,19 @@ def read_doppler(path: str | os.PathLike) -> PolyDoppler:
         sv = attr_str(f, "schema_version")
         if sv != SCHEMA_VERSION:
             raise ProductError(f"{path}: doppler schema version {sv} is not supported (expected {SCHEMA_VERSION})")
-        for k in ("prf_hz", "wavelength_m"):
-            if k not in f.attrs:
-                raise ProductError(f"{path}: malformed doppler product, attribute '{k}' missing")
+        prf = attr_number(f, "prf_hz", lo=PRF_HZ[0], hi=PRF_HZ[1], unit="Hz")
+        lam = attr_number(f, "wavelength_m", lo=C_LIGHT / CARRIER_HZ[1], hi=C_LIGHT / CARRIER_HZ[0], unit="m")
         blocks = {}
         if "blocks" in f:
-            for k in f["blocks"]:
-                v = f["blocks"][k][()]
+            g = f["blocks"]
+            if not isinstance(g, h5py.Group):
+                raise ProductError(f"{path}: malformed doppler product, 'blocks' is not a group")
+            for k in g:
+                v = read_array(g, k, "fiub", ndim=1, finite=False)
                 blocks[k] = v.astype(bool) if k in ("valid", "outlier") else v
-        try:
-            summary = DopplerSummary.from_dict(json.loads(attr_str(f, "summary_json") or "{}"),
-                                               f"{path}: summary_json")
-        except json.JSONDecodeError:
-            raise ProductError(f"{path}: malformed doppler product, summary_json is not JSON") from None
+            if len({v.size for v in blocks.values()}) > 1:
+                raise ProductError(f"{path}: malformed doppler product, the block columns differ in length")
+        summary = DopplerSummary.from_dict(attr_json(f, "summary_json", {}), f"{path}: summary_json")
         params = provenance(f).get("parameters") or {}
-        return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path),
-                            float(f.attrs["prf_hz"]), float(f.attrs["wavelength_m"]), blocks, summary,
-                            params if isinstance(params, dict) else {})
+        return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path), prf, lam, blocks,
+                            summary, params if isinstance(params, dict) else {})

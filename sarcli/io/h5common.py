@@ -22,11 +22,14 @@ so an interrupted run never leaves a half product behind.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import datetime as _dt
 import hashlib
 import json
 import os
-from collections.abc import Iterator, Mapping, Sequence
+import threading
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +38,7 @@ import numpy as np
 
 from sarcli import __version__
 from sarcli.errors import ProductError
-from sarcli.io.atomic import atomic_path
+from sarcli.io.atomic import atomic_path, readable_name
 from sarcli.io.provenance import current
 from sarcli.model import checks as ck
 
@@ -97,22 +100,40 @@ def cf_time_units(epoch_utc: str) -> str:
     return "seconds since " + parse_utc(epoch_utc).strftime("%Y-%m-%dT%H:%M:%S.%f")
 
 
-def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22) -> str:
-    """Hex SHA-256 of a file's bytes."""
+def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22, stop: threading.Event | None = None) -> str:
+    """Hex SHA-256 of a file's bytes (``stop`` set: abandoned, returns "")."""
     h = hashlib.sha256()
     with open(path, "rb") as f:
         while block := f.read(chunk):
+            if stop is not None and stop.is_set():
+                return ""
             h.update(block)
     return h.hexdigest()
 
 
-def describe_inputs(paths: Sequence[str | os.PathLike]) -> list[dict[str, str]]:
-    """Provenance entries ``{"path", "sha256"}`` for input files (file name only, for portability)."""
+def describe_inputs(paths: Sequence[str | os.PathLike], stop: threading.Event | None = None) -> list[dict[str, str]]:
+    """Provenance entries ``{"path", "sha256"}`` for input files (file name only, for portability; the
+    bytes of a product still waiting in an :func:`sarcli.io.atomic.all_or_nothing` block are hashed)."""
     out = []
     for p in paths:
-        p = Path(p)
-        out.append({"path": p.name, "sha256": sha256_file(p) if p.is_file() else ""})
+        p, now = Path(p), readable_name(p)
+        out.append({"path": p.name, "sha256": sha256_file(now, stop=stop) if now.is_file() else ""})
     return out
+
+
+@contextlib.contextmanager
+def hashing(paths: Sequence[str | os.PathLike]) -> Iterator[Callable[[], list[dict[str, str]]]]:
+    """:func:`describe_inputs` computed on a thread while the caller works (a product's inputs are read
+    once more by the hash, overlapped with the processing instead of before it); yields the function
+    that waits for the entries. Leaving the block early abandons the hash."""
+    stop = threading.Event()
+    with ThreadPoolExecutor(1, thread_name_prefix="sarcli-sha256") as pool:
+        # the worker thread does not see this context's all_or_nothing block: run it in a copy
+        future = pool.submit(contextvars.copy_context().run, describe_inputs, list(paths), stop)
+        try:
+            yield future.result
+        finally:
+            stop.set()
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -155,21 +176,23 @@ def atomic_h5(
     """Open a new product for writing; it appears at ``path`` only if the block completes.
 
     Yields an ``h5py.File``. Use :func:`dataset` to create datasets so that they are
-    reproducible (no timestamps) and carry units.
+    reproducible (no timestamps) and carry units. The inputs are hashed on a thread meanwhile
+    (:func:`hashing`); their entries are written when the block completes.
     """
-    with atomic_path(path, ".tmp") as tmp:
+    with atomic_path(path, ".tmp") as tmp, hashing(inputs) as described:
         with h5py.File(tmp, "w", libver=("earliest", "v110"), track_order=False) as f:
             f.attrs["product_type"] = product_type
             f.attrs["schema_version"] = schema_version
             f.attrs["software_version"] = __version__
             f.attrs["created_utc"] = created_utc()
             f.attrs["command_line"] = command_line if command_line is not None else current().command_line
-            f.attrs["inputs"] = json.dumps(describe_inputs(inputs))
             f.attrs["parameters"] = json.dumps(to_jsonable(dict(parameters or {})), sort_keys=True)
             f.attrs["Conventions"] = CONVENTIONS
             yield f
             label_remaining_dimensions(f)
-    _probed.add(_version_key(path))  # written here and now: reading it back needs no probe
+            f.attrs["inputs"] = json.dumps(described())
+        _probed.add(_version_key(tmp))  # written here and now: reading it back needs no probe (a rename
+        # keeps the device, inode, size and modification time the key is made of)
 
 
 def dataset(

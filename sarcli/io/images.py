@@ -33,7 +33,7 @@ import json
 import os
 import tempfile
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -53,15 +53,39 @@ SENSORS = {"ceos": "RADARSAT-1 (CEOS raw)", "sentinel1-l0": "Sentinel-1 (level-0
            "measured": "GB-SAR (sarcli gbsar scan)", "imported": "imported frequency sweeps"}
 
 
+#: GDAL's block cache while a GeoTIFF is written, MB (its default, 5 % of the machine's memory, would hold
+#: a large raster's blocks a second time)
+GDAL_CACHE_MB = 64
+
+
+@dataclass(frozen=True)
+class Strips:
+    """A raster too large to hold twice, given as ``shape`` and ``strips()``: an iterator of (first row,
+    rows) covering the rows in order (rows in multiples of 256, the GeoTIFF's tile height, but the last)."""
+
+    shape: tuple[int, int]
+    strips: Any
+
+    def __iter__(self) -> Iterator[tuple[int, np.ndarray]]:
+        return iter(self.strips())
+
+
 @dataclass(frozen=True)
 class Band:
-    """One float32 band: ``data`` (2-D), ``description``, ``unit`` (UDUNITS-like: ``dB``, ``rad``,
-    ``mm``, ``1``), the overview reduction (module docstring)."""
+    """One float32 band: ``data`` (2-D array or :class:`Strips`), ``description``, ``unit``
+    (UDUNITS-like: ``dB``, ``rad``, ``mm``, ``1``), the overview reduction (module docstring), and
+    ``derive``, applied to the data (each strip of it) before writing: bands derived from one
+    :class:`Strips` object compute it once (the amplitude and its dB of a map projection)."""
 
-    data: np.ndarray
+    data: np.ndarray | Strips
     description: str
     unit: str
     overview: OverviewKind = "mean"
+    derive: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def values(self, data: np.ndarray) -> np.ndarray:
+        """This band's float32 values of (a strip of) its data."""
+        return np.asarray(data if self.derive is None else self.derive(data), np.float32)
 
 
 @dataclass(frozen=True)
@@ -165,13 +189,42 @@ def overview_factors(shape: tuple[int, int], block: int = BLOCK) -> list[int]:
     return out
 
 
-def _write_plain(path: str, bands: Sequence[np.ndarray], profile: dict[str, Any]) -> None:
-    import rasterio
+def _band_strips(bands: Sequence[Band], shape: tuple[int, int]) -> Iterator[tuple[int, list[np.ndarray]]]:
+    """(first row, float32 values of every band) strip by strip: the :class:`Strips` sources iterated
+    once each, in lockstep (their strips must cover the same rows); array bands cut to the same rows."""
+    sources: dict[int, Strips] = {id(b.data): b.data for b in bands if isinstance(b.data, Strips)}
+    if not sources:
+        yield 0, [b.values(b.data) for b in bands]
+        return
+    iters = {k: iter(v) for k, v in sources.items()}
+    row = 0
+    while row < shape[0]:
+        got = {k: next(it, None) for k, it in iters.items()}
+        if any(g is None or g[0] != row for g in got.values()) or len({g[1].shape[0] for g in got.values()}) != 1:
+            raise ProductError(f"GeoTIFF band strips do not cover the rows alike at row {row}")
+        rows = next(iter(got.values()))[1].shape[0]
+        yield row, [b.values(got[id(b.data)][1] if isinstance(b.data, Strips) else
+                             np.asarray(b.data)[row:row + rows]) for b in bands]
+        row += rows
 
-    with rasterio.open(path, "w", driver="GTiff", count=len(bands), dtype="float32", nodata=np.nan,
-                       height=bands[0].shape[0], width=bands[0].shape[1], **profile) as dst:
-        for i, b in enumerate(bands, start=1):
-            dst.write(np.asarray(b, np.float32), i)
+
+def _write_overview(base: str, path: str, factor: int, kinds: Sequence[OverviewKind]) -> None:
+    """The overview level ``factor`` of every band of the GeoTIFF ``base``, computed from it in row
+    windows of whole cells (so exactly as :func:`reduce_block` of the whole band)."""
+    import rasterio
+    from rasterio.windows import Window
+
+    with rasterio.open(base) as src:
+        n, m = src.height, src.width
+        nn, mm = -(-n // factor), -(-m // factor)
+        step = factor * max(1, BLOCK // factor)  # rows per window: whole cells, at least one tile high
+        with rasterio.open(path, "w", driver="GTiff", count=src.count, dtype="float32", nodata=np.nan,
+                           height=nn, width=mm) as dst:
+            for a in range(0, n, step):
+                rows = min(step, n - a)
+                for i, kind in enumerate(kinds, start=1):
+                    cells = reduce_block(src.read(i, window=Window(0, a, m, rows)), factor, kind)
+                    dst.write(cells, i, window=Window(0, a // factor, mm, cells.shape[0]))
 
 
 def _attach_overviews(vrt: Path, files: Sequence[tuple[int, str]], n_bands: int) -> None:
@@ -207,20 +260,24 @@ def write_geotiff(
     points ``gcps`` given as (row, col, x, y, z) in ``crs`` (e.g. EPSG:4326 lon/lat for slant-range
     geometry images). ``crs`` is anything rasterio accepts ("EPSG:32610", 4326, a WKT string).
     ``tags``: :func:`provenance_tags` (and anything else to keep, upper-case keys by convention).
+    Bands given as :class:`Strips` are written strip by strip and their overviews computed from the
+    written file in row windows: a raster never held whole gives the same file as the array would.
     """
     import rasterio
     import rasterio.shutil
     from rasterio.control import GroundControlPoint
     from rasterio.crs import CRS
     from rasterio.errors import NotGeoreferencedWarning
+    from rasterio.windows import Window
 
     bands = [bands] if isinstance(bands, Band) else list(bands)
     if not bands:
         raise ProductError("a GeoTIFF needs at least one band")
-    shape = np.shape(bands[0].data)
+    shape = tuple(bands[0].data.shape) if isinstance(bands[0].data, Strips) else np.shape(bands[0].data)
     for b in bands:
-        if np.ndim(b.data) != 2 or np.shape(b.data) != shape:
-            raise ProductError(f"GeoTIFF bands must be 2-D arrays of one shape, got {np.shape(b.data)}")
+        got = tuple(b.data.shape) if isinstance(b.data, Strips) else np.shape(b.data)
+        if len(got) != 2 or got != shape:
+            raise ProductError(f"GeoTIFF bands must be 2-D arrays of one shape, got {got}")
     if (transform is None) == (gcps is None):
         raise ProductError("a GeoTIFF needs either an affine transform or ground control points")
     crs_obj = CRS.from_epsg(crs) if isinstance(crs, int) else CRS.from_user_input(crs)
@@ -229,14 +286,19 @@ def write_geotiff(
     if not folder.is_dir():
         raise ProductError(f"output folder {folder} does not exist")
     profile: dict[str, Any] = {"crs": crs_obj, "transform": transform} if transform is not None else {}
-    with tempfile.TemporaryDirectory(prefix=f".{path.name}.", dir=folder) as td, warnings.catch_warnings():
+    if shape[0] >= BLOCK and shape[1] >= BLOCK:
+        profile.update(tiled=True, blockxsize=BLOCK, blockysize=BLOCK)
+    with tempfile.TemporaryDirectory(prefix=f".{path.name}.", dir=folder) as td, warnings.catch_warnings(), \
+            rasterio.Env(GDAL_CACHEMAX=GDAL_CACHE_MB):
         # GCPs are attached after the file is opened (rasterio warns in between); overview levels have none
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
         base = os.path.join(td, "full.tif")
         with rasterio.open(base, "w", driver="GTiff", count=len(bands), dtype="float32", nodata=np.nan,
                            height=shape[0], width=shape[1], **profile) as dst:
+            for row, values in _band_strips(bands, shape):
+                for i, v in enumerate(values, start=1):
+                    dst.write(v, i, window=Window(0, row, shape[1], v.shape[0]))
             for i, b in enumerate(bands, start=1):
-                dst.write(np.asarray(b.data, np.float32), i)
                 dst.set_band_description(i, b.description)
                 dst.set_band_unit(i, b.unit)
             dst.scales = (1.0,) * len(bands)
@@ -250,7 +312,7 @@ def write_geotiff(
         levels = []
         for f in overview_factors(shape):
             name = f"ov{f}.tif"
-            _write_plain(os.path.join(td, name), [reduce_block(b.data, f, b.overview) for b in bands], {})
+            _write_overview(base, os.path.join(td, name), f, [b.overview for b in bands])
             levels.append((f, name))
         vrt = Path(td) / "full.vrt"
         rasterio.shutil.copy(base, vrt, driver="VRT")

@@ -155,16 +155,30 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
         tg.attrs[k] = float(v)
 
 
+#: bytes of one ``/image`` chunk at most (HDF5's default chunk cache is 1 MiB: a chunk that a block
+#: boundary splits stays in the cache until the next block completes it)
+CHUNK_BYTES = 1 << 20
+
+
+def image_chunks(shape: tuple[int, int]) -> tuple[int, int]:
+    """HDF5 chunks of ``/image``: whole lines (no padding of the line to a multiple of a chunk width: a
+    6354-sample line in 2048-wide chunks stored 29 % of padding), as many as fit in :data:`CHUNK_BYTES`."""
+    n, m = (max(1, int(v)) for v in shape)
+    return min(n, max(1, CHUNK_BYTES // (8 * m))), m
+
+
 @contextlib.contextmanager
 def slc_writer(path: str | os.PathLike, meta: SLC, shape: tuple[int, int], inputs: tuple = (),
                compression: str | None = None) -> Iterator[h5py.Dataset]:
-    """Create the product atomically and yield the empty ``/image`` dataset to fill block by block.
+    """Create the product atomically and yield the empty ``/image`` dataset to fill block by block
+    (rows in any order).
 
     ``meta`` carries everything but the image (its ``image`` may be empty); metadata that is only
     known after processing (axes, Doppler, timings, parameters) can be set on ``meta`` inside the
-    block (:meth:`SLC.update_from`): it is written when the block exits.
+    block (:meth:`SLC.update_from`): it is written when the block exits. The inputs are hashed
+    meanwhile (:func:`sarcli.io.h5common.atomic_h5`).
     """
-    chunks = (min(shape[0], 256), min(shape[1], 2048))
+    chunks = image_chunks(shape)
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, meta.parameters, inputs) as f:
         ds = f.create_dataset("image", shape=shape, dtype=np.complex64, chunks=chunks, track_times=False,
                               **({"compression": compression} if compression else {}))

@@ -237,20 +237,27 @@ def coherence_cmd(
     pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of the first image]."),
     csv: Path = typer.Option(None, "--csv", help="CSV of the PS time series."),
     plot: Path = typer.Option(None, "--plot", help="PNG: coherence map and PS displacement series."),
+    workers: int = typer.Option(None, "--workers", help="Run the pixel-block tasks on a local Dask cluster of "
+                                "this many processes."),
+    scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Run them on this Dask scheduler "
+                                  "(tcp://host:8786)."),
     json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
     """Temporal coherence |sum z|/sum|z|, persistent-scatterer selection and PS phase/displacement series.
 
-    The images are read block by block (bounded memory, however many there are).
+    The images are read block by block (bounded memory, however many there are), as a task graph
+    over pixel blocks (here, or on a Dask cluster with --workers / --scheduler: the same result).
 
     Examples:
 
       sarcli gbsar coherence p1.h5 p2.h5 p3.h5 p4.h5 --threshold 0.99 -o ps.h5 --csv ps.csv --plot ps.png
+
+      sarcli gbsar coherence scans/*.h5 -o ps.h5 --workers 2
     """
     from sarcli.workflows import gbsar_coherence as wf
 
     cfg = wf.Config(images=tuple(images), output=output, threshold=threshold, dynamic_range_db=dynamic_range_db,
-                    pol=pol, csv=csv, plot=plot)
+                    pol=pol, csv=csv, plot=plot, workers=workers, scheduler=scheduler)
     run_workflow(wf, cfg, json_out)
 
 
