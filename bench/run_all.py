@@ -1,7 +1,8 @@
 """Run every benchmark module ``bench/bench_*.py`` (each has ``main()``), in name order.
 
-Each benchmark writes its own table to ``bench/results/<name>.md`` (and ``.json``); the README quotes
-them. Pass module names to run a subset: ``python -m bench.run_all bench_orbit``.
+Each benchmark writes its own table to ``bench/results/<name>.md`` (and ``.json``); then
+``docs/validation.md`` is rewritten from them (:mod:`bench.validation`). Pass module names to run a
+subset: ``python -m bench.run_all bench_orbit``.
 """
 
 from __future__ import annotations
@@ -23,7 +24,9 @@ def main(argv: list[str]) -> int:
         print(f"== {name}", flush=True)
         importlib.import_module(f"bench.{name}").main()
         print(f"== {name} done in {time.perf_counter() - t0:.1f} s", flush=True)
-    return 0
+    from bench.validation import main as write_validation
+
+    return write_validation([])
 
 
 if __name__ == "__main__":

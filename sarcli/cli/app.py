@@ -17,12 +17,13 @@ import typer
 import typer.main
 from typer.core import TyperCommand
 
-from sarcli import __version__
 from sarcli.cli.common import SarcliGroup, make_typer, terminal
 
 #: command -> (modules of sarcli.cli.commands that register it, the first paragraph of its help), in the
 #: order of ``sarcli --help`` (commands, then command groups)
 COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
+    "batch": (("batch",), "Process a folder of scenes: raw -> Doppler -> SLC + GeoTIFF + quicklook, as one "
+                          "task graph."),
     "design": (("design",), "Derive resolutions, PRF window, Doppler samples and swath, and check each "
                             "constraint."),
     "doppler": (("doppler",), "Estimate the Doppler centroid (baseband CDE + ambiguity) and the Doppler rate."),
@@ -86,15 +87,19 @@ app = make_typer(
         "  sarcli simulate samples/rs1_point.toml -o raw.h5\n\n"
         "  sarcli info raw.h5 --json\n\n"
         "  sarcli -v --log-file run.log run steps.toml\n\n"
-        "Run 'sarcli COMMAND --help' for a command's options and examples. Exit status: 0 done, 1 bad data, "
-        "2 usage or configuration, 3 instrument fault, 130 interrupted."
+        "Run 'sarcli COMMAND --help' (or -h) for a command's options and examples. Exit status: 0 done, 1 bad "
+        "data, 2 usage or configuration, 3 instrument fault, 130 interrupted (docs/cli.md)."
     ),
+    add_completion=True,  # --install-completion / --show-completion (bash, zsh, fish, PowerShell)
+    context_settings={"help_option_names": ["-h", "--help"]},  # inherited by every command
 )
 
 
 def _print_version(value: bool) -> None:
     if value:
-        typer.echo(__version__)
+        from sarcli import versions  # GDAL and PROJ: asked only here
+
+        typer.echo(versions.version_text())
         raise typer.Exit()
 
 
@@ -102,7 +107,7 @@ def _print_version(value: bool) -> None:
 def _root(
     ctx: typer.Context,
     version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
-                                 help="Print the version and exit."),
+                                 help="Print the versions of sarcli, numpy, numba, GDAL, PROJ, ... and exit."),
     verbose: int = typer.Option(0, "--verbose", "-v", count=True,
                                 help="Show diagnostics on stderr: -v progress of each step, -vv debugging detail."),
     quiet: bool = typer.Option(False, "--quiet", "-q",

@@ -58,6 +58,7 @@ from scipy.optimize import brentq
 from sarcli.doppler.ambiguity import coverage_factor
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.errors import SarcliError
+from sarcli.threads import budget
 
 
 @dataclass
@@ -106,7 +107,7 @@ def look_powers(spectrum: np.ndarray, prf: float, f_ref: float, ka: float, band:
     out = []
     for a, b in ((-0.5 * band, 0.0), (0.0, 0.5 * band)):
         g = (h * np.sqrt(_overlap(f_rel, prf / n, a, b))).astype(np.complex64)
-        y = sfft.ifft(spectrum * g[:, None], axis=0, workers=-1)
+        y = sfft.ifft(spectrum * g[:, None], axis=0, workers=budget())
         out.append(np.sum(y.real**2 + y.imag**2, axis=1, dtype=np.float64))
     return out[0], out[1]
 
@@ -166,7 +167,7 @@ def look_balance(echo: np.ndarray, prf: float, line0: np.ndarray, n_lines: np.nd
         if not np.any(ok):
             continue
         spec = sfft.fft(np.asarray(echo[:, sample0[j]:sample0[j] + n_samples[j]], np.complex64), axis=0,
-                        workers=-1)
+                        workers=budget())
         for i in np.flatnonzero(ok):
             def d_of(f, seg=owned[i], spec=spec, ka_j=ka[j]):
                 return float(_balance(*look_powers(spec, prf, f, ka_j, band), [seg])[0])

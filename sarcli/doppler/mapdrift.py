@@ -30,6 +30,7 @@ import numpy as np
 import scipy.fft as sfft
 
 from sarcli.errors import SarcliError
+from sarcli.threads import budget
 
 
 @dataclass
@@ -76,10 +77,10 @@ def map_drift(rc: np.ndarray, prf: float, wavelength: float, range_m: float, ran
     half = 0.5 * look_fraction * prf
     sel1 = (df >= -half) & (df < 0)
     sel2 = (df >= 0) & (df < half)
-    S = sfft.fft(np.asarray(rc, np.complex64), axis=0, workers=-1)
+    S = sfft.fft(np.asarray(rc, np.complex64), axis=0, workers=budget())
     power = np.mean(np.abs(S) ** 2, axis=1)  # azimuth spectrum: the looks' energy-weighted centres
     f1, f2 = (float(np.sum(df[m] * power[m]) / np.sum(power[m])) for m in (sel1, sel2))
-    S = sfft.fft(S, axis=1, workers=-1)  # 2-D spectrum (f_eta rows, f_range columns)
+    S = sfft.fft(S, axis=1, workers=budget())  # 2-D spectrum (f_eta rows, f_range columns)
     k_rg = sfft.fftfreq(n_rg)  # cycles per sample
     fr = float(fr0)
     history = [fr]
@@ -96,8 +97,8 @@ def map_drift(rc: np.ndarray, prf: float, wavelength: float, range_m: float, ran
         shift = range_m * (1.0 / np.sqrt(arg) - 1.0 / np.sqrt(arg_c)) / range_spacing_m  # samples
         X = S * np.exp(2j * np.pi * shift[:, None] * k_rg[None, :])
         X *= np.exp(1j * np.pi * df**2 / fr)[:, None]
-        X = sfft.ifft(X, axis=1, workers=-1)
-        looks = [np.abs(sfft.ifft(np.where(sel[:, None], X, 0), axis=0, workers=-1)) ** 2 for sel in (sel1, sel2)]
+        X = sfft.ifft(X, axis=1, workers=budget())
+        looks = [np.abs(sfft.ifft(np.where(sel[:, None], X, 0), axis=0, workers=budget())) ** 2 for sel in (sel1, sel2)]
         drift = _drift_lines(looks[0], looks[1]) / prf
         new = 1.0 / (1.0 / fr + drift / (f2 - f1))
         history.append(new)

@@ -19,6 +19,7 @@ import scipy.fft as sfft
 from sarcli.errors import SarcliError
 from sarcli.focus.rangecomp import chirp_band, range_filter, reference_pulse
 from sarcli.model.raw import Radar, RawProduct
+from sarcli.threads import budget
 
 #: samples beyond the pulse a swath needs before range compression is worth it (RC-CDE, MLCC/MLBF, map-drift)
 MIN_EXTRA_SAMPLES = 16
@@ -42,7 +43,7 @@ def _spectrum(echo: np.ndarray, radar: Radar, replica: np.ndarray | None):
     # before the window (negative samples, wrapped to the end) never meet those after it
     nfft = sfft.next_fast_len(n + nref)
     H, f = range_filter(radar, nfft, "rect", replica)
-    S = sfft.fft(np.asarray(echo, np.complex64), nfft, axis=1, workers=-1)
+    S = sfft.fft(np.asarray(echo, np.complex64), nfft, axis=1, workers=budget())
     S *= H.astype(np.complex64)[None, :]
     valid = slice(nref // 2, n - nref // 2)
     return S, f, H, valid
@@ -52,7 +53,7 @@ def range_compress_valid(echo: np.ndarray, radar: Radar, replica: np.ndarray | N
                          ) -> tuple[np.ndarray, slice]:
     """Range-compressed echo restricted to fully covered samples: (array complex64, sample slice)."""
     S, _, _, valid = _spectrum(echo, radar, replica)
-    out = sfft.ifft(S, axis=1, workers=-1)[:, valid]
+    out = sfft.ifft(S, axis=1, workers=budget())[:, valid]
     return out.astype(np.complex64), valid
 
 
@@ -63,7 +64,7 @@ def range_compress_extended(echo: np.ndarray, radar: Radar, replica: np.ndarray 
     their raw-sample indices, starting at -(n_ref//2))."""
     S, _, _, valid = _spectrum(echo, radar, replica)
     n, half = echo.shape[1], valid.start
-    out = sfft.ifft(S, axis=1, workers=-1)
+    out = sfft.ifft(S, axis=1, workers=budget())
     idx = np.arange(-half, n + half) % out.shape[1]  # negative samples wrapped to the end of the FFT
     return out[:, idx].astype(np.complex64), slice(-half, n + half)
 
@@ -86,5 +87,5 @@ def range_looks(echo: np.ndarray, radar: Radar, replica: np.ndarray | None = Non
         if not np.any(ref_amp[sel] > 0):
             raise SarcliError("range sub-look has no bandwidth (pulse shorter than a sample?)")
         centres.append(float(np.sum(f[sel] * ref_amp[sel]) / np.sum(ref_amp[sel])))
-        looks.append(sfft.ifft(np.where(sel[None, :], S, 0), axis=1, workers=-1)[:, valid].astype(np.complex64))
+        looks.append(sfft.ifft(np.where(sel[None, :], S, 0), axis=1, workers=budget())[:, valid].astype(np.complex64))
     return looks[0], looks[1], np.array(centres)

@@ -20,6 +20,7 @@ import scipy.fft as sfft
 from numba import njit, prange
 
 from sarcli.focus.windows import table_lookup, window, window_table
+from sarcli.threads import fft_workers
 
 
 @njit(parallel=True, cache=True)
@@ -72,12 +73,12 @@ def backproject_numpy(rc, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba
 def upsample_range(rc: np.ndarray, factor: int, workers: int = -1) -> np.ndarray:
     """Fourier interpolation of range lines by an integer factor (baseband spectrum, zero padding)."""
     n = rc.shape[1]
-    spec = sfft.fft(rc, axis=1, workers=workers)
+    spec = sfft.fft(rc, axis=1, workers=fft_workers(workers))
     out = np.zeros((rc.shape[0], n * factor), spec.dtype)
     h = (n + 1) // 2
     out[:, :h] = spec[:, :h]
     out[:, n * factor - (n - h):] = spec[:, h:]
-    return sfft.ifft(out, axis=1, overwrite_x=True, workers=workers) * factor
+    return sfft.ifft(out, axis=1, overwrite_x=True, workers=fft_workers(workers)) * factor
 
 
 def backproject_grid(rc: np.ndarray, r_first: float, dr: float, wavelength: float, pos: np.ndarray,

@@ -13,7 +13,16 @@ too far from the track on the ground (a 1 km hill at Radarsat-1's incidence of a
   (x, y) -> (line, column) is linear over its Delaunay triangles (the map is smooth: the error of the
   linear pieces is below 0.01 pixel for a Radarsat-1 swath), and the intensity is resampled
   bilinearly (sqrt after resampling), NaN outside the image. Pixel spacing: the larger of the ground
-  range and azimuth spacings of the looks (no aliasing) unless given. Written in row strips.
+  range and azimuth spacings of the looks (no aliasing) unless given. Computed and written in row
+  strips (the map raster of a full scene is never held whole).
+
+Both are Cloud-Optimized GeoTIFFs (:func:`sarcli.io.images.write_geotiff`) with two bands, the amplitude
+(``1``, overviews sqrt(mean |z|^2)) and the amplitude in dB (20 log10, overviews in power), the
+provenance tags of the SLC (sensor, wavelength, look side, first and last zero-Doppler times, the SLC
+file's SHA-256, the fully focused lines) and a QGIS style showing the dB band. Lines outside the fully
+focused span (``first_full_line..last_full_line``: lines without the whole processed aperture) are
+MASKED: a look cell that holds any such line is NaN (nodata) in the slant GeoTIFF, and so is every
+map pixel that falls between its rows; the tag ``FULLY_FOCUSED_LINES`` gives the span.
 """
 
 from __future__ import annotations
@@ -23,6 +32,9 @@ import numpy as np
 from sarcli.errors import SarcliError
 from sarcli.model.slc import SLC
 from sarcli.model.terrain import ConstantHeight, Terrain
+
+#: rows of the GeoTIFFs computed and written at a time (a multiple of their 256-row tiles)
+STRIP = 512
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
@@ -42,16 +54,46 @@ def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.nda
     return out
 
 
+def full_rows(slc: SLC, n_rows: int, looks_az: int) -> np.ndarray:
+    """Per multilooked row, whether all its ``looks_az`` lines are fully focused (first_full_line ..
+    last_full_line; a product that records no span counts as fully focused)."""
+    last = slc.last_full_line if slc.last_full_line >= 0 else slc.azimuth_time.size - 1
+    lines = np.arange(n_rows) * looks_az
+    return (lines >= slc.first_full_line) & (lines + looks_az - 1 <= last)
+
+
+def slc_tags(slc: SLC, inputs: tuple = (), extra: dict | None = None) -> dict[str, str]:
+    """The GeoTIFF provenance tags of an image made from ``slc`` (:func:`sarcli.io.images.provenance_tags`)."""
+    from sarcli.io.images import provenance_tags
+
+    last = slc.last_full_line if slc.last_full_line >= 0 else slc.azimuth_time.size - 1
+    return provenance_tags(
+        inputs, sensor=slc.source, wavelength_m=slc.radar.wavelength_m, look_side=slc.look_side,
+        acquisition=(slc.epoch_utc, float(slc.azimuth_time[0]), float(slc.azimuth_time[-1])),
+        LINE_TIME="zero-Doppler", ALGORITHM=slc.algorithm,
+        FULLY_FOCUSED_LINES=f"{slc.first_full_line}..{last} of {slc.azimuth_time.size} (others masked: nodata)",
+        **(extra or {}))
+
+
+def _amplitude_bands(amp, inten: np.ndarray, full: np.ndarray, geometry: str):
+    """The two bands of an amplitude GeoTIFF from ``amp`` (array or Strips): the amplitude and its dB,
+    and the QGIS style of the dB band, stretched over the fully focused rows of the intensity ``inten``
+    (the multilooked image the amplitude is resampled from: the same distribution, held anyway)."""
+    from sarcli.io.images import Band, Style, amplitude_db, db_stretch
+
+    with np.errstate(divide="ignore"):
+        lo, hi = db_stretch(10.0 * np.log10(inten[full].astype(np.float64)))
+    return ([Band(amp, f"amplitude, {geometry}", "1", "power"),
+             Band(amp, f"amplitude 20 log10|z|, {geometry}", "dB", "power_db",
+                  derive=lambda a: amplitude_db(a, floor_db=None))],
+            Style(2, lo, hi, "gray", "amplitude (dB)"))
+
+
 def recorded_height(slc: SLC) -> float:
-    """The terrain height the product was focused with (``parameters["terrain"]``: the constant height,
-    or the DEM's mean height), 0 m when it records none: a first-order height for quantities that
-    depend weakly on it (ground spacings)."""
-    t = slc.parameters.get("terrain") if isinstance(slc.parameters, dict) else None
-    if isinstance(t, dict):
-        for key in ("height_m", "mean_height_m"):
-            if isinstance(t.get(key), int | float) and np.isfinite(t[key]):
-                return float(t[key])
-    return 0.0
+    """The terrain height the product was focused with (:func:`sarcli.io.slc.recorded_height`)."""
+    from sarcli.io.slc import recorded_height as from_parameters
+
+    return from_parameters(slc.parameters)
 
 
 def _look_axes(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int]):
@@ -96,35 +138,57 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
-                        terrain: Terrain | None = None) -> None:
-    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m)."""
-    import warnings
+                        terrain: Terrain | None = None, inputs: tuple = (),
+                        intensity: np.ndarray | None = None) -> None:
+    """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m);
+    ``tags``: extra tags beside :func:`slc_tags`; ``inputs``: the files it was made from (the SLC).
+    ``intensity``: ``multilook(slc.image, looks_az, looks_rg)`` when the caller has it (then ``slc``
+    needs no image)."""
+    from sarcli.io.images import Strips, write_geotiff
 
-    from rasterio.errors import NotGeoreferencedWarning
-
-    from sarcli.io.images import write_geotiff
-
-    inten = multilook(slc.image, looks_az, looks_rg)
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     gcps = slant_gcps(slc, inten.shape, looks_az, looks_rg, terrain or ConstantHeight(0.0))
-    with warnings.catch_warnings():
-        # the GCPs are attached after the file is opened: rasterio warns in between
-        warnings.simplefilter("ignore", NotGeoreferencedWarning)
-        write_geotiff(path, np.sqrt(inten), 4326, gcps=gcps, tags=tags,
-                      band_description="amplitude, slant-range geometry (lines: zero-Doppler time)")
+    full = full_rows(slc, inten.shape[0], looks_az)
+
+    def strips():
+        for a in range(0, inten.shape[0], STRIP):
+            amp = np.sqrt(inten[a:a + STRIP])
+            amp[~full[a:a + STRIP]] = np.nan
+            yield a, amp
+
+    bands, style = _amplitude_bands(Strips(inten.shape, strips), inten, full,
+                                    "slant-range geometry (lines: zero-Doppler time)")
+    write_geotiff(path, bands, 4326, gcps=gcps, tags=slc_tags(slc, inputs, tags), style=style)
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = 512):
-    """(amplitude float32 with NaN outside, rasterio Affine transform, CRS string) in a map projection,
-    pixels placed on ``terrain`` (default 0 m). With a DEM the coarse grid is made denser (``coarse``
-    at least 65): the inverse map is linear per triangle, and the terrain bends it on the scale of
-    the hills."""
+                spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = STRIP,
+                intensity: np.ndarray | None = None):
+    """(amplitude float32 with NaN outside the image and its fully focused lines, rasterio Affine
+    transform, CRS string) in a map projection, pixels placed on ``terrain`` (default 0 m). With a DEM
+    the coarse grid is made denser (``coarse`` at least 65): the inverse map is linear per triangle,
+    and the terrain bends it on the scale of the hills. ``intensity``: as in
+    :func:`write_slant_geotiff`."""
+    strips, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, coarse, strip, intensity)
+    out = np.empty(strips.shape, np.float32)
+    for a, rows in strips:
+        out[a:a + rows.shape[0]] = rows
+    return out, transform, crs
+
+
+def map_strips(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
+               spacing_m: float | None = None, terrain: Terrain | None = None, coarse: int = 33, strip: int = STRIP,
+               intensity: np.ndarray | None = None):
+    """:func:`map_project` as (:class:`sarcli.io.images.Strips` of ``strip`` map rows, transform, CRS): the
+    map raster is computed strip by strip as it is written, never held whole."""
     from pyproj import Transformer
     from rasterio.transform import Affine
     from scipy.interpolate import LinearNDInterpolator
     from scipy.ndimage import map_coordinates
 
-    inten = multilook(slc.image, looks_az, looks_rg)
+    from sarcli.io.images import Strips
+
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     n, m = inten.shape
     t, r = _look_axes(slc, looks_az, looks_rg, inten.shape)
     rows, cols = _grid_index(n, coarse), _grid_index(m, coarse)
@@ -154,29 +218,40 @@ def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None 
         raise SarcliError(f"map raster {ny} x {nx} is too large: increase the pixel spacing or the looks")
     rr, cc = np.meshgrid(rows.astype(float), cols.astype(float), indexing="ij")
     inv = LinearNDInterpolator(np.column_stack([x.ravel(), y.ravel()]), np.column_stack([rr.ravel(), cc.ravel()]))
-    out = np.full((ny, nx), np.nan, np.float32)
+    full = full_rows(slc, n, looks_az)
     xs = x0 + np.arange(nx) * spacing_m
-    for a in range(0, ny, strip):
-        b = min(ny, a + strip)
-        ys = y1 - np.arange(a, b) * spacing_m
-        gx, gy = np.meshgrid(xs, ys)
-        rc = inv(gx.ravel(), gy.ravel())
-        ok = np.all(np.isfinite(rc), axis=1)
-        vals = np.full(gx.size, np.nan, np.float32)
-        if np.any(ok):
-            vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
-        out[a:b] = np.sqrt(vals).reshape(gx.shape)
+
+    def strips():
+        for a in range(0, ny, strip):
+            b = min(ny, a + strip)
+            ys = y1 - np.arange(a, b) * spacing_m
+            gx, gy = np.meshgrid(xs, ys)
+            rc = inv(gx.ravel(), gy.ravel())
+            ok = np.all(np.isfinite(rc), axis=1)
+            vals = np.full(gx.size, np.nan, np.float32)
+            if np.any(ok):
+                vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
+                # a pixel between two rows takes both: masked unless both are fully focused
+                lo = np.clip(np.floor(rc[ok, 0]).astype(np.int64), 0, n - 1)
+                hi = np.clip(np.ceil(rc[ok, 0]).astype(np.int64), 0, n - 1)
+                vals[np.flatnonzero(ok)[~(full[lo] & full[hi])]] = np.nan
+            yield a, np.sqrt(vals).reshape(gx.shape)
+
     # pixel (i, j) centre at (x0 + j s, y1 - i s): the raster's corner is half a pixel up-left of it
     transform = Affine(spacing_m, 0.0, x0 - 0.5 * spacing_m, 0.0, -spacing_m, y1 + 0.5 * spacing_m)
-    return out, transform, crs
+    return Strips((ny, nx), strips), transform, crs
 
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
-                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None) -> str:
-    """Map-projected amplitude GeoTIFF (NaN nodata, tiled, deflate, overviews); returns the CRS used."""
+                      spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None,
+                      inputs: tuple = (), intensity: np.ndarray | None = None) -> str:
+    """Map-projected amplitude COG (NaN nodata; module docstring); returns the CRS used.
+    ``intensity``: as in :func:`write_slant_geotiff`."""
     from sarcli.io.images import write_geotiff
 
-    amp, transform, crs = map_project(slc, looks_az, looks_rg, crs, spacing_m, terrain)
-    write_geotiff(path, amp, crs, transform=transform, tags=tags,
-                  band_description="amplitude, map projected (bilinear intensity resampling)")
+    inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
+    amp, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, intensity=inten)
+    bands, style = _amplitude_bands(amp, inten, full_rows(slc, inten.shape[0], looks_az),
+                                    "map projected (bilinear intensity resampling)")
+    write_geotiff(path, bands, crs, transform=transform, tags=slc_tags(slc, inputs, tags), style=style)
     return crs

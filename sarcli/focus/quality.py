@@ -21,11 +21,12 @@ The peak phase is that of the original (not demodulated) image at the interpolat
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ProductError, SarcliError
 
 
 @dataclass
@@ -180,12 +181,17 @@ def truth_targets(truth: dict | None) -> list[tuple[float, float]]:
     if truth is None or "targets" not in truth:
         return []
     t = truth["targets"]
-    names = t.dtype.names or ()
+    names = getattr(getattr(t, "dtype", None), "names", None) or ()
+    if getattr(t, "ndim", 0) != 1:
+        raise ProductError("the product's truth table of targets is not a table (one row per target)")
     tk = next((k for k in ("zero_doppler_time_s", "zero_doppler_time") if k in names), None)
     rk = next((k for k in ("closest_range_m", "slant_range_m") if k in names), None)
     if tk is None or rk is None:
         return []
-    return [(float(a), float(b)) for a, b in zip(t[tk], t[rk], strict=True)]
+    out = [(float(a), float(b)) for a, b in zip(t[tk], t[rk], strict=True)]
+    if not all(math.isfinite(a) and math.isfinite(b) for a, b in out):
+        raise ProductError("the product's truth table of targets holds non-finite positions")
+    return out
 
 
 def azimuth_ground_spacing(slc) -> float:
@@ -219,6 +225,7 @@ def measure_targets(slc, positions: list[tuple[float, float]], truth_known: bool
         e_rg = (m["col"] - col) * dr
         rec = {
             "range_m": float(r[0] + m["col"] * dr), "azimuth_time_s": float(t[0] + m["row"] * dt),
+            "row": float(m["row"]), "col": float(m["col"]),
             "irw_range_m": m["irw_range_px"] * dr, "irw_azimuth_m": m["irw_azimuth_px"] * ds_az,
             "pslr_range_db": m["pslr_range_db"], "pslr_azimuth_db": m["pslr_azimuth_db"],
             "islr_range_db": m["islr_range_db"], "islr_azimuth_db": m["islr_azimuth_db"],
@@ -237,18 +244,32 @@ def image_statistics(blocks) -> dict:
     ``blocks``: the image, or an iterable of row blocks (bounded memory for full scenes).
     contrast = std(I) / mean(I) (higher = sharper; 1 for fully developed speckle);
     entropy = -sum(p ln p), p = I / S, S = sum(I) (lower = sharper; the autofocus criterion),
-    accumulated as ln S - sum(I ln I) / S in float64.
+    accumulated as ln S - sum(I ln I) / S in float64 (:func:`line_sums`, :func:`statistics_from_sums`).
     """
     if isinstance(blocks, np.ndarray):
         blocks = [blocks]
-    n, s1, s2, sl = 0, 0.0, 0.0, 0.0
-    for b in blocks:
-        inten = (np.abs(np.asarray(b)) ** 2).astype(np.float64).ravel()
-        n += inten.size
-        s1 += inten.sum()
-        s2 += np.dot(inten, inten)
-        pos = inten[inten > 0]
-        sl += float(np.dot(pos, np.log(pos)))
+    return statistics_from_sums(sum((line_sums(b).sum(axis=0) for b in blocks), np.zeros(4)))
+
+
+def line_sums(block: np.ndarray, rows: int = 256) -> np.ndarray:
+    """Per line of ``block`` (lines x samples, complex): (n_pixels, sum I, sum I^2, sum I ln I), float64
+    (lines, 4), I = |z|^2 (0 ln 0 = 0). The statistics of any set of lines are those of the sums of
+    their rows (:func:`statistics_from_sums`): a focused block's sums are computed as it streams past,
+    in any order. Worked in chunks of ``rows`` lines (bounded temporaries)."""
+    block = np.asarray(block)
+    out = np.empty((block.shape[0], 4))
+    out[:, 0] = block.shape[1]
+    for a in range(0, block.shape[0], rows):
+        inten = (np.abs(block[a:a + rows]) ** 2).astype(np.float64)
+        out[a:a + rows, 1] = inten.sum(axis=1)
+        out[a:a + rows, 2] = np.einsum("ij,ij->i", inten, inten)
+        out[a:a + rows, 3] = np.einsum("ij,ij->i", inten, np.log(np.where(inten > 0, inten, 1.0)))
+    return out
+
+
+def statistics_from_sums(sums: np.ndarray) -> dict:
+    """contrast, entropy and n_pixels (:func:`image_statistics`) from summed (n, sum I, sum I^2, sum I ln I)."""
+    n, s1, s2, sl = (float(v) for v in sums)
     if not s1 > 0:
         raise SarcliError("image has no signal: statistics undefined")
     mean = s1 / n

@@ -1,5 +1,11 @@
 """Quicklook PNG of an SLC: multilooked amplitude in dB, axes in slant range (km) and zero-Doppler time (s).
 
+The time axis is ZERO-DOPPLER time: a target is drawn at its closest approach, not when the beam centre
+crossed it. With a squinted beam the two differ by dt = t_beam - t_zd = f_dc / f_r (the Doppler
+f = f_r (t - t_zd) equals the centroid at the beam centre): RADARSAT-1 at f_dc = -6560 Hz, f_r = -1781 Hz/s
+gives +3.7 s, so a target a scene defines at beam-centre time 0 appears at -3.7 s. The axis label says
+so, with the mid-swath value of the product's Doppler.
+
 Extra looks are added (block averages of intensity) until the picture is at most ``max_pixels`` on its
 longer side, so a full scene still gives a light PNG.
 """
@@ -14,17 +20,42 @@ from sarcli.focus.geocode import multilook
 from sarcli.model.slc import SLC
 
 
+def quicklook_looks(shape: tuple[int, int], looks_az: int = 1, looks_rg: int = 1,
+                    max_pixels: int = 1600) -> tuple[int, int, int]:
+    """(looks in azimuth, looks in range, extra factor) of the quicklook of an image of ``shape``: the
+    looks asked for times the factor that fits ``max_pixels`` on the longer side."""
+    n, m = shape
+    f = max(1, math.ceil(max(n / looks_az, m / looks_rg) / max_pixels))
+    return looks_az * f, looks_rg * f, f
+
+
 def write_slc_quicklook(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, max_pixels: int = 1600,
-                        title: str | None = None) -> None:
+                        title: str | None = None, intensity: np.ndarray | None = None) -> None:
+    """``intensity``: ``multilook(slc.image, *quicklook_looks(...)[:2])`` when the caller has it (then
+    ``slc`` needs no image)."""
     from sarcli.io.images import write_quicklook
 
-    n, m = slc.image.shape
-    f = max(1, math.ceil(max(n / looks_az, m / looks_rg) / max_pixels))
-    la, lr = looks_az * f, looks_rg * f
-    inten = multilook(slc.image, la, lr)
+    n, m = slc.azimuth_time.size, slc.slant_range.size
+    la, lr, f = quicklook_looks((n, m), looks_az, looks_rg, max_pixels)
+    inten = multilook(slc.image, la, lr) if intensity is None else intensity
     t = slc.azimuth_time
     r = slc.slant_range / 1e3
     extent = (r[0], r[min(m, inten.shape[1] * lr) - 1], t[min(n, inten.shape[0] * la) - 1], t[0])
     looks = f"{la} x {lr} looks" + (f": {looks_az} x {looks_rg} asked, x{f} to fit {max_pixels} px" if f > 1 else "")
     write_quicklook(path, np.sqrt(inten), title=title or f"SLC amplitude ({looks})", dynamic_range_db=40.0,
-                    extent=extent, xlabel="slant range (km)", ylabel="zero-Doppler time (s)")
+                    extent=extent, xlabel="slant range (km)", ylabel=time_axis_label(slc))
+
+
+def time_axis_label(slc: SLC) -> str:
+    """``zero-Doppler time (s)`` and, for a squinted image, how far the beam-centre time is (module
+    docstring), from the Doppler the product was focused with (mid block, mid range)."""
+    d = slc.doppler
+    fdc, fr = np.asarray(d.fdc_hz, np.float64), np.asarray(d.fr_hz_per_s, np.float64)
+    if fdc.size == 0 or fr.size == 0:
+        return "zero-Doppler time (s)"
+    k, j = fdc.shape[0] // 2, fdc.shape[-1] // 2
+    f, r = float(fdc[k, j]), float(fr[k, j])
+    if not (np.isfinite(f) and np.isfinite(r) and r != 0.0) or abs(f / r) < 0.005:
+        return "zero-Doppler time (s)"
+    return (f"zero-Doppler time (s); beam-centre time = this {f / r:+.2f} s\n"
+            f"(squint: fdc {f:.0f} Hz / fr {r:.0f} Hz/s at mid-swath)")

@@ -31,6 +31,7 @@ from sarcli.errors import SarcliError
 from sarcli.focus.windows import window
 from sarcli.model.constants import C_LIGHT as C
 from sarcli.model.raw import Radar
+from sarcli.threads import fft_workers
 
 
 def reference_pulse(radar: Radar, replica: np.ndarray | None = None) -> np.ndarray:
@@ -87,9 +88,9 @@ def compress_lines(lines: np.ndarray, h: np.ndarray, n_out: int, workers: int = 
     """
     x = np.zeros((lines.shape[0], h.size), h.dtype)
     x[:, :lines.shape[1]] = lines
-    x = sfft.fft(x, axis=1, overwrite_x=True, workers=workers)
+    x = sfft.fft(x, axis=1, overwrite_x=True, workers=fft_workers(workers))
     x *= h[None, :]
-    x = sfft.ifft(x, axis=1, overwrite_x=True, workers=workers)
+    x = sfft.ifft(x, axis=1, overwrite_x=True, workers=fft_workers(workers))
     return x[:, :n_out]
 
 

@@ -57,7 +57,6 @@ FFT lengths are 5-smooth (:func:`smooth_len`): pocketfft is markedly slower on f
 from __future__ import annotations
 
 import math
-import os
 import queue
 import time
 import warnings
@@ -86,6 +85,7 @@ from sarcli.focus.windows import parse_window, window_table
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import ConstantHeight, Terrain
+from sarcli.threads import fft_workers
 
 RANGE_GUARD = 64  # range samples beyond the correlation's wrap-free length (SRC impulse response)
 CHUNK = 64  # azimuth-frequency rows per chunk of the filter + upsampling + RCMC pass
@@ -124,7 +124,7 @@ class RdOptions:
     0.467 cycles/sample, the edge of a Radarsat-1 chirp sampled at 1.07 x its band);
     orbit_timing: with an Earth orbit, place targets at their exact zero-Doppler time (see
     :func:`orbit_time_correction`) instead of the hyperbolic model's; workers: threads (scipy's
-    convention: negative = every usable core).
+    convention: negative counts from the thread budget, :func:`sarcli.threads.budget`).
     """
 
     range_window: str = "kaiser:2.5"
@@ -721,16 +721,15 @@ def _fft_inplace(y: np.ndarray, axis: int, inverse: bool, workers: int, cols: in
     f = sfft.ifft if inverse else sfft.fft
     for c in range(0, y.shape[1], cols if axis == 0 else y.shape[1]):
         v = y[:, c:c + cols] if axis == 0 else y
-        r = f(v, axis=axis, overwrite_x=True, workers=workers)
+        r = f(v, axis=axis, overwrite_x=True, workers=fft_workers(workers))
         if not np.may_share_memory(r, v):
             v[...] = r
 
 
 def _n_threads(workers: int) -> int:
-    """Threads for the chunk pool: ``workers`` (scipy's convention: negative = every usable core)."""
-    if workers >= 0:
-        return max(1, workers)
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else max(1, os.cpu_count() or 1)
+    """Threads for the chunk pool: ``workers`` (scipy's convention: negative counts from the thread
+    budget, :func:`sarcli.threads.budget`: every usable core unless the caller limited it)."""
+    return max(1, workers) if workers >= 0 else fft_workers(workers)
 
 
 def _range_rows(y: np.ndarray, off: int, data: np.ndarray, gain: np.ndarray | None, workers: int,

@@ -14,7 +14,9 @@ For a surface point P at height h, horizontal distance y from the rail:
 * Delta-f (f_B = f_A + df): ``phi = -(4 pi/c) df R`` -> +24.0 deg/m for df = -10 MHz (15 m a fringe).
 * Combined: ``phi = -(4 pi/c)(f_B R_B - f_A R_A)``: 16.0 deg/m at 100 m (24.0 - 8.0).
 
-The model phase of a flat surface at ``z_ref`` is removed and the residual converted: DInSAR ->
+The model phase of a flat surface at ``z_ref`` is removed, the wrapped residual is unwrapped spatially
+(:mod:`sarcli.gbsar.unwrap`, SNAPHU weighted by the coherence; one 2 pi multiple per connected
+component fixed by its median) and the unwrapped residual converted: DInSAR ->
 LOS displacement ``-residual lam/(4 pi)`` (mm, + = away from the radar); cross-track and combined
 -> height ``z_ref + residual/(dphi/dh)``; delta-f -> range offset ``-residual c/(4 pi df)`` from the pixel
 range (delta-f measures range, not height; ambiguity c/(2 df)).
@@ -130,6 +132,14 @@ class Interferogram:
     value_unit: str
     rate: dict
     support: np.ndarray  # bool, both images have data (phase, coherence, residual NaN elsewhere)
+    unwrapped: np.ndarray  # residual unwrapped spatially (rad), NaN outside the connected components
+    component: np.ndarray  # int32 connected component of each pixel (0: none)
+    unwrap_method: str
+
+
+#: independent looks of a w x w boxcar coherence on sarcli's GB-SAR images (about 1.7 x oversampled in
+#: each axis by the Hamming-windowed focusing): w^2 / 2.8, ~9 looks for the default 5 x 5 window
+LOOKS_PER_WINDOW_PIXEL = 1.0 / 2.8
 
 
 def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5,
@@ -156,17 +166,21 @@ def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5
         model = -4 * np.pi * (fb * rb - fa * r0) / C_LIGHT
     resid = np.angle(z * np.exp(-1j * np.nan_to_num(model))).astype(np.float32)
     resid[~(np.isfinite(model) & ok)] = np.nan
+    from sarcli.gbsar.unwrap import unwrap
+
+    unw = unwrap(resid, coh, nlooks=window * window * LOOKS_PER_WINDOW_PIXEL)
     lam_a, lam_b = C_LIGHT / fa, C_LIGHT / fb
+    uphase = unw.phase.astype(np.float64)
     if mode == "dinsar":
-        value, name, unit = -resid * lam_a / (4 * np.pi) * 1e3, "los_displacement", "mm"
+        value, name, unit = -uphase * lam_a / (4 * np.pi) * 1e3, "los_displacement", "mm"
         rate = {"deg_per_m_los": -720.0 / lam_a}
     elif mode == "deltaf":
-        value, name, unit = -resid * C_LIGHT / (4 * np.pi * dfreq), "range_offset", "m"
+        value, name, unit = -uphase * C_LIGHT / (4 * np.pi * dfreq), "range_offset", "m"
         rate = {"deg_per_m_range": -720.0 * dfreq / C_LIGHT, "ambiguity_m": C_LIGHT / (2 * abs(dfreq))}
     else:
         with np.errstate(invalid="ignore", divide="ignore"):
             dphi_dh = 4 * np.pi * bv / (lam_b * rb)
-            value = z_ref_m + resid / dphi_dh
+            value = z_ref_m + uphase / dphi_dh
         name, unit = "height", "m"
         rate = {"deg_per_m_height_at_100m": np.degrees(4 * np.pi * bv / (lam_b * 100.0)),
                 "height_ambiguity_at_100m_m": abs(lam_b * 100.0 / (2 * bv))}
@@ -174,4 +188,5 @@ def interfere(a: GbsarImage, b: GbsarImage, mode: str, pol: str, window: int = 5
     with np.errstate(invalid="ignore"):
         value = np.where(coh >= min_coherence, value, np.nan).astype(np.float32)  # NaN coherence fails too
     return Interferogram(phase=phase, coherence=coh, model_phase=np.nan_to_num(model).astype(np.float32),
-                         residual=resid, value=value, value_name=name, value_unit=unit, rate=rate, support=ok)
+                         residual=resid, value=value, value_name=name, value_unit=unit, rate=rate, support=ok,
+                         unwrapped=unw.phase, component=unw.component, unwrap_method=unw.method)

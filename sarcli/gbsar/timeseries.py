@@ -20,10 +20,14 @@ def temporal_coherence(stack: np.ndarray) -> np.ndarray:
     """``|sum z| / sum |z|`` over axis 0 of an (N, ...) complex stack (0 where all are zero)."""
     if stack.shape[0] < 2:
         raise SarcliError("temporal coherence needs at least 2 images")
-    num = np.abs(np.sum(stack, axis=0, dtype=np.complex128))
-    den = np.sum(np.abs(stack), axis=0, dtype=np.float64)
+    return coherence_from_sums(np.sum(stack, axis=0, dtype=np.complex128),
+                               np.sum(np.abs(stack), axis=0, dtype=np.float64))
+
+
+def coherence_from_sums(sum_z: np.ndarray, sum_abs: np.ndarray) -> np.ndarray:
+    """``|sum z| / sum |z|`` from the two sums (accumulated image by image: :mod:`sarcli.parallel.gbsar`)."""
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / den, 0.0).astype(np.float32)
+        return np.where(sum_abs > 0, np.abs(sum_z) / sum_abs, 0.0).astype(np.float32)
 
 
 def select_ps(gamma: np.ndarray, mean_amplitude: np.ndarray, threshold: float,

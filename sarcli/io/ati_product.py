@@ -31,10 +31,13 @@ from sarcli.io.h5common import (
     attr_json,
     attr_number,
     attr_value,
+    cf_time_units,
+    coordinate,
     dataset,
     open_product,
     read_array,
     to_jsonable,
+    units_from_name,
 )
 from sarcli.model import checks as ck
 from sarcli.model.raw import LOOK_SIDES
@@ -72,18 +75,21 @@ def write_ati(path: str | os.PathLike, *, epoch_utc: str, t_ref_s: float, look_s
         f.attrs["look_side"] = look_side
         f.attrs["detection"] = json.dumps(to_jsonable(detection), sort_keys=True)
         f.attrs["movers_json"] = json.dumps(to_jsonable(movers), sort_keys=True)
-        dataset(f, "azimuth_time", np.asarray(azimuth_time, np.float64), units="s",
-                description="zero-Doppler time after epoch_utc")
-        dataset(f, "slant_range", np.asarray(slant_range, np.float64), units="m",
-                description="closest-approach slant range")
+        t = coordinate(f, "azimuth_time", np.asarray(azimuth_time, np.float64), cf_time_units(epoch_utc),
+                       "zero-Doppler time of each image line")
+        r = coordinate(f, "slant_range", np.asarray(slant_range, np.float64), "m", "closest-approach slant range")
         dataset(f, "image_before", np.asarray(image_before, np.complex64), units="1", chunks=chunks,
-                description="channel-0 RD image, stationary-scene focusing")
+                description="channel-0 RD image, stationary-scene focusing", dims=(t, r))
         if image_after is not None:
             dataset(f, "image_after", np.asarray(image_after, np.complex64), units="1", chunks=chunks,
-                    description="movers compensated and relocated")
+                    description="movers compensated and relocated", dims=(t, r))
         dataset(f, "ati_phase", np.asarray(ati_phase, np.float32), units="rad", chunks=chunks,
-                description="arg(Z1 conj(Z0)), co-registered, channel 1 ahead")
-        dataset(f, "movers", _table(movers), description="one row per mover, SI units, 1-sigma uncertainties")
+                description="arg(Z1 conj(Z0)), co-registered, channel 1 ahead", dims=(t, r))
+        tab = _table(movers)
+        ds = dataset(f, "movers", tab, units="1", description="one row per mover, SI units, 1-sigma uncertainties: "
+                     "units of each field in field_units")
+        ds.attrs["field_units"] = json.dumps({n: units_from_name(n.removesuffix("_sigma")) or "1"
+                                              for n in tab.dtype.names})
 
 
 def read_ati(path: str | os.PathLike) -> dict[str, Any]:

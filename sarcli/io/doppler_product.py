@@ -9,6 +9,7 @@ Layout (SI units)::
                       ambiguity_confidence, ambiguity_resolved (int 0/1: whether a source decided the
                       PRF ambiguity; 0 = the centroid's ambiguity is a guess), fr_method, n_az_blocks,
                       n_rg_blocks
+    /block            int64 (n_blocks,) block index, the dimension of every /blocks dataset
     /blocks           one 1-D dataset per column, one row per (azimuth block, range block), row-major
                       (azimuth outer): range_m, azimuth_time_s, fdc_baseband_hz, quality, weight, valid,
                       ambiguity, margin_prf, fdc_hz (absolute, per block), fdc_fit_hz, fdc_orbit_hz,
@@ -27,18 +28,45 @@ from __future__ import annotations
 import json
 import os
 
+import h5py
 import numpy as np
 
 from sarcli.errors import ProductError
-from sarcli.io.h5common import atomic_h5, attr_str, dataset, group, open_product, provenance, require, to_jsonable
+from sarcli.io.h5common import (
+    atomic_h5,
+    attr_json,
+    attr_number,
+    attr_str,
+    coordinate,
+    dataset,
+    group,
+    open_product,
+    provenance,
+    read_array,
+    to_jsonable,
+    units_from_name,
+)
+from sarcli.model.constants import C_LIGHT
 from sarcli.model.doppler import PolyDoppler
 from sarcli.model.doppler_summary import DopplerSummary
 from sarcli.model.poly import Poly2D
+from sarcli.model.raw import CARRIER_HZ, PRF_HZ
 
 PRODUCT_TYPE = "doppler"
 SCHEMA_VERSION = "1"
 
-UNITS = {"range_m": "m", "azimuth_time_s": "s", "fdc_baseband_hz": "Hz", "quality": "1", "weight": "rad^-2",
+DESCRIPTIONS = {
+    "range_m": "slant range of the block centre", "azimuth_time_s": "raw time of the block centre, s after the "
+    "raw product's epoch_utc", "fdc_baseband_hz": "centroid estimate in the baseband (-PRF/2, PRF/2]",
+    "quality": "block quality |C|/E (magnitude of the lag-1 correlation over the energy)",
+    "weight": "fit weight (inverse phase variance)", "valid": "1 if the block's estimate is usable",
+    "ambiguity": "PRF ambiguity number of the block", "margin_prf": "distance of the estimate from the ambiguity "
+    "decision boundary, in PRFs", "fdc_hz": "absolute centroid of the block", "fdc_fit_hz": "the fitted model at the "
+    "block", "fdc_orbit_hz": "the orbit + attitude (geometry) centroid at the block", "fr_hz_per_s": "Doppler rate "
+    "of the block", "fr_seed_hz_per_s": "geometric Doppler rate the estimate started from", "look_seed_rad":
+    "look angle of the geometric seed", "range_seed_m": "slant range of the geometric seed", "outlier": "1 if the "
+    "fit rejected the block"}
+UNITS = {"range_m": "m", "azimuth_time_s": "s", "fdc_baseband_hz": "Hz", "quality": "1", "weight": "rad-2",
          "valid": "1", "ambiguity": "1", "margin_prf": "1", "fdc_hz": "Hz", "fdc_fit_hz": "Hz",
          "fdc_orbit_hz": "Hz", "fr_hz_per_s": "Hz/s", "fr_seed_hz_per_s": "Hz/s", "look_seed_rad": "rad",
          "range_seed_m": "m", "outlier": "1"}
@@ -46,6 +74,8 @@ UNITS = {"range_m": "m", "azimuth_time_s": "s", "fdc_baseband_hz": "Hz", "qualit
 
 def _write_poly(f, name: str, p: Poly2D, units: str) -> None:
     g = group(f, name)
+    g.attrs["description"] = f"2-D polynomial of the {'Doppler centroid' if units == 'Hz' else 'Doppler rate'} " \
+        "in range and azimuth time (x0, xs in m; y0, ys in s)"
     dataset(g, "coef", np.asarray(p.coef, np.float64), units=units,
             description="sum coef[i,j] ((range - x0)/xs)^i ((time - y0)/ys)^j")
     for k in ("x0", "xs", "y0", "ys"):
@@ -54,15 +84,17 @@ def _write_poly(f, name: str, p: Poly2D, units: str) -> None:
 
 
 def _read_poly(f, name: str, path) -> Poly2D:
-    if name not in f:
-        raise ProductError(f"{path}: malformed doppler product, missing '{name}'")
+    """A polynomial group: finite 2-D coefficients, finite offsets, positive finite scales (they divide),
+    an integer range power."""
+    if name not in f or not isinstance(f[name], h5py.Group):
+        raise ProductError(f"{path}: malformed doppler product, missing group '{name}'")
     g = f[name]
-    coef = require(g, "coef", path, shape_rank=2)[()]
-    try:
-        x0, xs, y0, ys = (float(g.attrs[k]) for k in ("x0", "xs", "y0", "ys"))
-        return Poly2D(coef, x0, xs, y0, ys, int(g.attrs.get("x_power", 0)))
-    except KeyError as e:
-        raise ProductError(f"{path}: malformed doppler product, '{name}' lacks attribute {e}") from None
+    coef = read_array(g, "coef", "f", ndim=2, min_size=1)
+    x0, y0 = (attr_number(g, k) for k in ("x0", "y0"))
+    xs, ys = (attr_number(g, k, lo=0.0) for k in ("xs", "ys"))
+    if xs == 0.0 or ys == 0.0:
+        raise ProductError(f"{path}: malformed doppler product, '{name}' has a zero scale")
+    return Poly2D(coef, x0, xs, y0, ys, attr_number(g, "x_power", 0, lo=-4, hi=4, integer=True))
 
 
 def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = (),
@@ -84,10 +116,16 @@ def write_doppler(path: str | os.PathLike, model: PolyDoppler, inputs: tuple = (
         f.attrs["ambiguity_confidence"] = float(s.ambiguity_confidence)
         f.attrs["ambiguity_resolved"] = np.int8(s.ambiguity_resolved)
         g = group(f, "blocks")
+        g.attrs["description"] = ("one value per (azimuth block, range block), row-major (azimuth outer): the "
+                                  "block estimates and the fit")
+        n = len(next(iter(model.blocks.values()))) if model.blocks else 0
+        b = coordinate(f, "block", np.arange(n, dtype=np.int64), "1",
+                       f"block index = azimuth block * {int(s.n_rg_blocks)} + range block")
         for k in sorted(model.blocks):
             v = np.asarray(model.blocks[k])
             v = v.astype(np.int8) if v.dtype == bool else v
-            dataset(g, k, v, units=UNITS.get(k))
+            dataset(g, k, v, units=UNITS.get(k, units_from_name(k) or "1"),
+                    description=DESCRIPTIONS.get(k, k.replace("_", " ")), dims=(b,) if v.ndim == 1 else ())
         _write_poly(f, "fdc_poly", model.fdc_poly, "Hz")
         _write_poly(f, "fr_poly", model.fr_poly, "Hz/s")
 
@@ -98,20 +136,19 @@ def read_doppler(path: str | os.PathLike) -> PolyDoppler:
         sv = attr_str(f, "schema_version")
         if sv != SCHEMA_VERSION:
             raise ProductError(f"{path}: doppler schema version {sv} is not supported (expected {SCHEMA_VERSION})")
-        for k in ("prf_hz", "wavelength_m"):
-            if k not in f.attrs:
-                raise ProductError(f"{path}: malformed doppler product, attribute '{k}' missing")
+        prf = attr_number(f, "prf_hz", lo=PRF_HZ[0], hi=PRF_HZ[1], unit="Hz")
+        lam = attr_number(f, "wavelength_m", lo=C_LIGHT / CARRIER_HZ[1], hi=C_LIGHT / CARRIER_HZ[0], unit="m")
         blocks = {}
         if "blocks" in f:
-            for k in f["blocks"]:
-                v = f["blocks"][k][()]
+            g = f["blocks"]
+            if not isinstance(g, h5py.Group):
+                raise ProductError(f"{path}: malformed doppler product, 'blocks' is not a group")
+            for k in g:
+                v = read_array(g, k, "fiub", ndim=1, finite=False)
                 blocks[k] = v.astype(bool) if k in ("valid", "outlier") else v
-        try:
-            summary = DopplerSummary.from_dict(json.loads(attr_str(f, "summary_json") or "{}"),
-                                               f"{path}: summary_json")
-        except json.JSONDecodeError:
-            raise ProductError(f"{path}: malformed doppler product, summary_json is not JSON") from None
+            if len({v.size for v in blocks.values()}) > 1:
+                raise ProductError(f"{path}: malformed doppler product, the block columns differ in length")
+        summary = DopplerSummary.from_dict(attr_json(f, "summary_json", {}), f"{path}: summary_json")
         params = provenance(f).get("parameters") or {}
-        return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path),
-                            float(f.attrs["prf_hz"]), float(f.attrs["wavelength_m"]), blocks, summary,
-                            params if isinstance(params, dict) else {})
+        return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path), prf, lam, blocks,
+                            summary, params if isinstance(params, dict) else {})

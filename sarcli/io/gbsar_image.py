@@ -36,6 +36,7 @@ from sarcli.io.h5common import (
     attr_json,
     attr_number,
     attr_str,
+    coordinate,
     dataset,
     group,
     open_product,
@@ -69,10 +70,17 @@ def write_gbsar_image(path: str | os.PathLike, img: GbsarImage, parameters: dict
             f.attrs["permittivity"] = float(img.permittivity)
             if img.grid_z_m is not None:
                 f.attrs["grid_z_m"] = float(img.grid_z_m)
-        dataset(f, "image", np.asarray(img.image, np.complex64), units="1", chunks=True, compression="gzip")
-        dataset(f, "range", np.asarray(img.range_m, np.float64), units="m")
-        dataset(f, "azimuth", np.asarray(img.azimuth_m, np.float64), units="m")
-        dataset(f, "algorithm_map", np.asarray(img.algorithm_map, np.uint8), units="1", compression="gzip")
+        pol = coordinate(f, "polarization", np.array([p.encode() for p in img.polarizations]), "1",
+                         "transmit-receive polarization")
+        grid = img.grid_z_m is not None
+        rg = coordinate(f, "range", np.asarray(img.range_m, np.float64), "m",
+                        "y across the scan frame (grid image rows)" if grid else "R0, distance from the rail line")
+        az = coordinate(f, "azimuth", np.asarray(img.azimuth_m, np.float64), "m",
+                        "x along the scan frame (grid image columns)" if grid else "x along the rail")
+        dataset(f, "image", np.asarray(img.image, np.complex64), units="1", chunks=True, compression="gzip",
+                description="focused complex image (polarization, range, azimuth)", dims=(pol, rg, az))
+        dataset(f, "algorithm_map", np.asarray(img.algorithm_map, np.uint8), units="1", compression="gzip",
+                description="algorithm that focused each pixel: 0 not covered, 1 DF, 2 RD, 3 BP", dims=(rg, az))
         g = group(f, "site")
         for k, v in vars(img.site).items():
             g.attrs[k] = v

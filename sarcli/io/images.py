@@ -1,79 +1,397 @@
-"""Images for people: GeoTIFF (rasterio, real CRS, nodata, provenance tags, overviews) and PNG quicklooks.
+"""Images for people: Cloud-Optimized GeoTIFFs (rasterio, real CRS, nodata, units, provenance tags,
+overviews averaged in power, a QGIS style beside them) and PNG quicklooks.
 
-GeoTIFFs are written atomically (temporary file in the target folder, then rename).
+GeoTIFF layout (``write_geotiff``): GDAL's COG driver (tiled 256 x 256, deflate with the floating-point
+predictor, overviews after the full-resolution image, the main IFD first), float32 bands, nodata NaN.
+Overviews are computed here, one level per factor 2 until the picture fits one 256-pixel tile, with
+the reduction the band's quantity needs (``Band.overview``):
+
+- ``power``: an amplitude band, ``sqrt(mean(a^2))`` (GDAL's ``RMS``): the mean intensity
+- ``power_db``: a dB band, ``10 log10(mean(10^(x/10)))``: the mean intensity in dB (averaging dB values
+  instead would bias dark: the mean of the logs is the log of the geometric mean)
+- ``phase``: ``arg(sum exp(j phi))``, the circular mean (an average of wrapped phases is meaningless
+  across the +-pi cut)
+- ``mean``: the plain mean (coherence, displacement, heights, ratios)
+
+NaN (no data) pixels are left out of every mean; a cell with none left is NaN. The levels are written
+as GeoTIFFs, attached to a VRT of the full image as its overviews, and the COG driver copies the VRT
+with ``OVERVIEWS=FORCE_USE_EXISTING`` (GDAL computes none itself).
+
+Every GeoTIFF carries provenance tags (:func:`provenance_tags`: software, version, creation time,
+command line, input files with their SHA-256, and the sensor, wavelength, look side and acquisition
+times when the image has them), per band a description, a unit, scale 1 and offset 0, and a QGIS
+style ``NAME.qml`` beside it (:class:`Style`; QGIS loads it with the layer) so the default stretch is
+readable: dB bands as grey from a 2nd to a 99.5th percentile, phase on a cyclic colour ramp.
+
+All files are written atomically (temporary file in the target folder, then rename).
 """
 
 from __future__ import annotations
 
+import datetime as _dt
+import json
 import os
-from collections.abc import Mapping, Sequence
-from typing import Any
+import tempfile
+import warnings
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 
 from sarcli.errors import ProductError
 from sarcli.io.atomic import atomic_path  # re-exported: plots and CSV writers import it from here
 
+OverviewKind = Literal["power", "power_db", "phase", "mean"]
+#: the tile size of every GeoTIFF (pixels); overviews go down until the image fits one tile
+BLOCK = 256
+
+#: readable names of the ``source`` attribute of raw/SLC products
+SENSORS = {"ceos": "RADARSAT-1 (CEOS raw)", "sentinel1-l0": "Sentinel-1 (level-0)", "nisar-l0b": "NISAR L0B",
+           "matlab": "RADARSAT-1 (Cumming & Wong MATLAB block)", "simulated": "simulated (sarcli simulate)",
+           "measured": "GB-SAR (sarcli gbsar scan)", "imported": "imported frequency sweeps"}
+
+
+#: GDAL's block cache while a GeoTIFF is written, MB (its default, 5 % of the machine's memory, would hold
+#: a large raster's blocks a second time)
+GDAL_CACHE_MB = 64
+
+
+@dataclass(frozen=True)
+class Strips:
+    """A raster too large to hold twice, given as ``shape`` and ``strips()``: an iterator of (first row,
+    rows) covering the rows in order (rows in multiples of 256, the GeoTIFF's tile height, but the last)."""
+
+    shape: tuple[int, int]
+    strips: Any
+
+    def __iter__(self) -> Iterator[tuple[int, np.ndarray]]:
+        return iter(self.strips())
+
+
+@dataclass(frozen=True)
+class Band:
+    """One float32 band: ``data`` (2-D array or :class:`Strips`), ``description``, ``unit``
+    (UDUNITS-like: ``dB``, ``rad``, ``mm``, ``1``), the overview reduction (module docstring), and
+    ``derive``, applied to the data (each strip of it) before writing: bands derived from one
+    :class:`Strips` object compute it once (the amplitude and its dB of a map projection)."""
+
+    data: np.ndarray | Strips
+    description: str
+    unit: str
+    overview: OverviewKind = "mean"
+    derive: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def values(self, data: np.ndarray) -> np.ndarray:
+        """This band's float32 values of (a strip of) its data."""
+        return np.asarray(data if self.derive is None else self.derive(data), np.float32)
+
+
+@dataclass(frozen=True)
+class Style:
+    """The QGIS style written beside the GeoTIFF: ``band`` (1-based) drawn from ``vmin`` to ``vmax``
+    in grey (``cmap = "gray"``) or on a matplotlib colour map (``twilight`` for phase, ...)."""
+
+    band: int
+    vmin: float
+    vmax: float
+    cmap: str = "gray"
+    label: str = ""
+
+
+def _tiff_datetime(iso_utc: str) -> str:
+    t = _dt.datetime.strptime(iso_utc, "%Y-%m-%dT%H:%M:%S.%fZ")
+    return t.strftime("%Y:%m:%d %H:%M:%S")
+
+
+def utc_after(epoch_utc: str, seconds: float) -> str:
+    """ISO-8601 UTC of ``seconds`` after the ISO-8601 ``epoch_utc`` (microseconds)."""
+    from sarcli.io.h5common import parse_utc
+
+    t = parse_utc(epoch_utc) + _dt.timedelta(seconds=float(seconds))
+    return t.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+
+
+def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | None = None,
+                    wavelength_m: float | None = None, look_side: str | None = None,
+                    acquisition: tuple[str, float, float] | None = None, **extra: Any) -> dict[str, str]:
+    """The GeoTIFF metadata of an image: who made it and from what (``SOFTWARE``, ``SOFTWARE_VERSION``,
+    ``CREATED_UTC`` (``SOURCE_DATE_EPOCH`` when set), ``COMMAND_LINE`` (the caller's, as products
+    record it), ``INPUTS`` (JSON list of ``{path, sha256}``)), what was observed (``SENSOR``,
+    ``WAVELENGTH_M``, ``LOOK_SIDE``, ``ACQUISITION_START_UTC``/``_STOP_UTC`` from ``acquisition`` =
+    (epoch, first s, last s)), the TIFF's own ``TIFFTAG_SOFTWARE``/``TIFFTAG_DATETIME``, and ``extra``
+    (upper-cased keys; dicts and lists as JSON)."""
+    from sarcli import __version__
+    from sarcli.io.h5common import created_utc, describe_inputs
+    from sarcli.io.provenance import current
+
+    created = created_utc()
+    tags: dict[str, Any] = {
+        "SOFTWARE": "sarcli", "SOFTWARE_VERSION": __version__, "CREATED_UTC": created,
+        "COMMAND_LINE": current().command_line, "INPUTS": json.dumps(describe_inputs(inputs)),
+        "TIFFTAG_SOFTWARE": f"sarcli {__version__}", "TIFFTAG_DATETIME": _tiff_datetime(created),
+    }
+    if sensor is not None:
+        tags["SENSOR"] = SENSORS.get(sensor, sensor)
+    if wavelength_m is not None:
+        tags["WAVELENGTH_M"] = repr(float(wavelength_m))
+    if look_side is not None:
+        tags["LOOK_SIDE"] = look_side
+    if acquisition is not None:
+        epoch, t0, t1 = acquisition
+        tags["ACQUISITION_START_UTC"] = utc_after(epoch, t0)
+        tags["ACQUISITION_STOP_UTC"] = utc_after(epoch, t1)
+    for k, v in extra.items():
+        if v is not None:
+            tags[k.upper()] = json.dumps(v, sort_keys=True, default=float) if isinstance(v, dict | list | tuple) \
+                else str(v)
+    return {k: str(v) for k, v in tags.items()}
+
+
+def reduce_block(data: np.ndarray, factor: int, kind: OverviewKind) -> np.ndarray:
+    """One overview level: ``factor`` x ``factor`` cells (partial cells at the edges kept, of size
+    ceil(n / factor) as GDAL's levels), reduced as ``kind`` says (module docstring), NaN ignored."""
+    a = np.asarray(data, np.float64)
+    n, m = a.shape
+    nn, mm = -(-n // factor), -(-m // factor)
+    pad = np.full((nn * factor, mm * factor), np.nan)
+    pad[:n, :m] = a
+    cells = pad.reshape(nn, factor, mm, factor)
+    ok = np.isfinite(cells)
+    count = ok.sum(axis=(1, 3))
+    if kind == "power":
+        val = np.where(ok, cells * cells, 0.0).sum(axis=(1, 3))
+    elif kind == "power_db":
+        val = np.where(ok, 10.0 ** (np.where(ok, cells, 0.0) / 10.0), 0.0).sum(axis=(1, 3))
+    elif kind == "phase":
+        val = np.where(ok, np.exp(1j * np.where(ok, cells, 0.0)), 0.0).sum(axis=(1, 3))
+    elif kind == "mean":
+        val = np.where(ok, cells, 0.0).sum(axis=(1, 3))
+    else:
+        raise ProductError(f"unknown overview reduction {kind!r}")
+    out = np.full((nn, mm), np.nan)
+    has = count > 0
+    if kind == "phase":
+        out[has] = np.angle(val[has])
+    else:
+        mean = val[has] / count[has]
+        out[has] = np.sqrt(mean) if kind == "power" else (10.0 * np.log10(mean) if kind == "power_db" else mean)
+    return out.astype(np.float32)
+
+
+def overview_factors(shape: tuple[int, int], block: int = BLOCK) -> list[int]:
+    """Factors 2, 4, ... until the reduced image fits one ``block`` x ``block`` tile."""
+    out, f = [], 2
+    while max(shape) / (f // 2) > block and min(shape) >= f:
+        out.append(f)
+        f *= 2
+    return out
+
+
+def _band_strips(bands: Sequence[Band], shape: tuple[int, int]) -> Iterator[tuple[int, list[np.ndarray]]]:
+    """(first row, float32 values of every band) strip by strip: the :class:`Strips` sources iterated
+    once each, in lockstep (their strips must cover the same rows); array bands cut to the same rows."""
+    sources: dict[int, Strips] = {id(b.data): b.data for b in bands if isinstance(b.data, Strips)}
+    if not sources:
+        yield 0, [b.values(b.data) for b in bands]
+        return
+    iters = {k: iter(v) for k, v in sources.items()}
+    row = 0
+    while row < shape[0]:
+        got = {k: next(it, None) for k, it in iters.items()}
+        if any(g is None or g[0] != row for g in got.values()) or len({g[1].shape[0] for g in got.values()}) != 1:
+            raise ProductError(f"GeoTIFF band strips do not cover the rows alike at row {row}")
+        rows = next(iter(got.values()))[1].shape[0]
+        yield row, [b.values(got[id(b.data)][1] if isinstance(b.data, Strips) else
+                             np.asarray(b.data)[row:row + rows]) for b in bands]
+        row += rows
+
+
+def _write_overview(base: str, path: str, factor: int, kinds: Sequence[OverviewKind]) -> None:
+    """The overview level ``factor`` of every band of the GeoTIFF ``base``, computed from it in row
+    windows of whole cells (so exactly as :func:`reduce_block` of the whole band)."""
+    import rasterio
+    from rasterio.windows import Window
+
+    with rasterio.open(base) as src:
+        n, m = src.height, src.width
+        nn, mm = -(-n // factor), -(-m // factor)
+        step = factor * max(1, BLOCK // factor)  # rows per window: whole cells, at least one tile high
+        with rasterio.open(path, "w", driver="GTiff", count=src.count, dtype="float32", nodata=np.nan,
+                           height=nn, width=mm) as dst:
+            for a in range(0, n, step):
+                rows = min(step, n - a)
+                for i, kind in enumerate(kinds, start=1):
+                    cells = reduce_block(src.read(i, window=Window(0, a, m, rows)), factor, kind)
+                    dst.write(cells, i, window=Window(0, a // factor, mm, cells.shape[0]))
+
+
+def _attach_overviews(vrt: Path, files: Sequence[tuple[int, str]], n_bands: int) -> None:
+    """Add ``<Overview>`` elements (one GeoTIFF per level) to every band of a GDAL VRT."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(vrt)
+    for band in tree.getroot().iter("VRTRasterBand"):
+        i = int(band.get("band"))
+        if i > n_bands:
+            continue
+        for _, name in files:
+            ov = ET.SubElement(band, "Overview")
+            src = ET.SubElement(ov, "SourceFilename", relativeToVRT="1")
+            src.text = name
+            ET.SubElement(ov, "SourceBand").text = str(i)
+    tree.write(vrt)
+
 
 def write_geotiff(
     path: str | os.PathLike,
-    array: np.ndarray,
+    bands: Band | Sequence[Band],
     crs: str | int,
     transform: Any | None = None,
     gcps: Sequence[tuple[float, float, float, float, float]] | None = None,
-    nodata: float | None = float("nan"),
     tags: Mapping[str, Any] | None = None,
-    band_description: str | None = None,
-    overviews: Sequence[int] = (2, 4, 8),
+    style: Style | None = None,
 ) -> None:
-    """Write a single-band float32 GeoTIFF: tiled, deflate-compressed, with overviews.
+    """Write a Cloud-Optimized GeoTIFF of float32 ``bands`` (nodata NaN) and its QGIS style (module
+    docstring).
 
     Georeferencing is either an affine ``transform`` (rasterio.Affine) in ``crs``, or ground control
     points ``gcps`` given as (row, col, x, y, z) in ``crs`` (e.g. EPSG:4326 lon/lat for slant-range
     geometry images). ``crs`` is anything rasterio accepts ("EPSG:32610", 4326, a WKT string).
+    ``tags``: :func:`provenance_tags` (and anything else to keep, upper-case keys by convention).
+    Bands given as :class:`Strips` are written strip by strip and their overviews computed from the
+    written file in row windows: a raster never held whole gives the same file as the array would.
     """
     import rasterio
+    import rasterio.shutil
     from rasterio.control import GroundControlPoint
     from rasterio.crs import CRS
+    from rasterio.errors import NotGeoreferencedWarning
+    from rasterio.windows import Window
 
-    a = np.asarray(array, dtype=np.float32)
-    if a.ndim != 2:
-        raise ProductError(f"GeoTIFF needs a 2-D array, got shape {a.shape}")
+    bands = [bands] if isinstance(bands, Band) else list(bands)
+    if not bands:
+        raise ProductError("a GeoTIFF needs at least one band")
+    shape = tuple(bands[0].data.shape) if isinstance(bands[0].data, Strips) else np.shape(bands[0].data)
+    for b in bands:
+        got = tuple(b.data.shape) if isinstance(b.data, Strips) else np.shape(b.data)
+        if len(got) != 2 or got != shape:
+            raise ProductError(f"GeoTIFF bands must be 2-D arrays of one shape, got {got}")
+    if (transform is None) == (gcps is None):
+        raise ProductError("a GeoTIFF needs either an affine transform or ground control points")
     crs_obj = CRS.from_epsg(crs) if isinstance(crs, int) else CRS.from_user_input(crs)
-    profile: dict[str, Any] = {
-        "driver": "GTiff", "height": a.shape[0], "width": a.shape[1], "count": 1, "dtype": "float32",
-        "compress": "deflate", "predictor": 3, "tiled": True, "blockxsize": 256, "blockysize": 256,
-        "nodata": nodata,
-    }
-    if a.shape[0] < 256 or a.shape[1] < 256:
-        profile.pop("blockxsize")
-        profile.pop("blockysize")
-        profile["tiled"] = False
-    if transform is not None:
-        profile["crs"] = crs_obj
-        profile["transform"] = transform
-    with atomic_path(path, ".tif") as tmp:
-        with rasterio.open(tmp, "w", **profile) as dst:
-            dst.write(a, 1)
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ProductError(f"output folder {folder} does not exist")
+    profile: dict[str, Any] = {"crs": crs_obj, "transform": transform} if transform is not None else {}
+    if shape[0] >= BLOCK and shape[1] >= BLOCK:
+        profile.update(tiled=True, blockxsize=BLOCK, blockysize=BLOCK)
+    with tempfile.TemporaryDirectory(prefix=f".{path.name}.", dir=folder) as td, warnings.catch_warnings(), \
+            rasterio.Env(GDAL_CACHEMAX=GDAL_CACHE_MB):
+        # GCPs are attached after the file is opened (rasterio warns in between); overview levels have none
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        base = os.path.join(td, "full.tif")
+        with rasterio.open(base, "w", driver="GTiff", count=len(bands), dtype="float32", nodata=np.nan,
+                           height=shape[0], width=shape[1], **profile) as dst:
+            for row, values in _band_strips(bands, shape):
+                for i, v in enumerate(values, start=1):
+                    dst.write(v, i, window=Window(0, row, shape[1], v.shape[0]))
+            for i, b in enumerate(bands, start=1):
+                dst.set_band_description(i, b.description)
+                dst.set_band_unit(i, b.unit)
+            dst.scales = (1.0,) * len(bands)
+            dst.offsets = (0.0,) * len(bands)
             if gcps is not None:
-                dst.gcps = ([GroundControlPoint(row=r, col=c, x=x, y=y, z=z) for r, c, x, y, z in gcps],
-                            crs_obj)
+                dst.gcps = ([GroundControlPoint(row=r, col=c, x=x, y=y, z=z) for r, c, x, y, z in gcps], crs_obj)
             if tags:
                 dst.update_tags(**{str(k): str(v) for k, v in tags.items()})
-            if band_description:
-                dst.set_band_description(1, band_description)
-            levels = [f for f in overviews if min(a.shape) // f >= 8]
-            if levels:
-                dst.build_overviews(levels, rasterio.enums.Resampling.average)
-                dst.update_tags(ns="rio_overview", resampling="average")
+            for i, b in enumerate(bands, start=1):
+                dst.update_tags(i, OVERVIEW_RESAMPLING=b.overview)
+        levels = []
+        for f in overview_factors(shape):
+            name = f"ov{f}.tif"
+            _write_overview(base, os.path.join(td, name), f, [b.overview for b in bands])
+            levels.append((f, name))
+        vrt = Path(td) / "full.vrt"
+        rasterio.shutil.copy(base, vrt, driver="VRT")
+        _attach_overviews(vrt, levels, len(bands))
+        with atomic_path(path, ".tif") as tmp:
+            rasterio.shutil.copy(str(vrt), tmp, driver="COG", COMPRESS="DEFLATE", PREDICTOR="YES",
+                                 BLOCKSIZE=str(BLOCK), OVERVIEWS="FORCE_USE_EXISTING" if levels else "NONE",
+                                 BIGTIFF="IF_SAFER")
+    if style is not None:
+        write_qgis_style(path.with_suffix(".qml"), style, n_bands=len(bands))
 
 
-def amplitude_db(image: np.ndarray, floor_db: float = -300.0) -> np.ndarray:
-    """20*log10|image| with a floor instead of -inf (float32)."""
+def write_qgis_style(path: str | os.PathLike, style: Style, n_bands: int = 1) -> None:
+    """A QGIS layer style (``.qml``; QGIS 3 loads ``NAME.qml`` beside ``NAME.tif`` with the layer):
+    one band in grey or on a colour ramp, stretched from ``vmin`` to ``vmax``, NaN transparent."""
+    import xml.etree.ElementTree as ET
+
+    if not 1 <= style.band <= n_bands:
+        raise ProductError(f"style band {style.band} is not one of the {n_bands} band(s)")
+    if not (np.isfinite(style.vmin) and np.isfinite(style.vmax) and style.vmax > style.vmin):
+        raise ProductError(f"style stretch {style.vmin}..{style.vmax} is empty")
+    root = ET.Element("qgis", version="3.22.0", styleCategories="AllStyleCategories")
+    pipe = ET.SubElement(root, "pipe")
+    lo, hi = f"{style.vmin:.6g}", f"{style.vmax:.6g}"
+    if style.cmap == "gray":
+        r = ET.SubElement(pipe, "rasterrenderer", type="singlebandgray", grayBand=str(style.band),
+                          gradient="BlackToWhite", opacity="1", alphaBand="-1")
+        ET.SubElement(r, "rasterTransparency")
+        ce = ET.SubElement(r, "contrastEnhancement")
+        ET.SubElement(ce, "minValue").text = lo
+        ET.SubElement(ce, "maxValue").text = hi
+        ET.SubElement(ce, "algorithm").text = "StretchToMinimumMaximum"
+    else:
+        from matplotlib import colormaps
+
+        cmap = colormaps[style.cmap]
+        r = ET.SubElement(pipe, "rasterrenderer", type="singlebandpseudocolor", band=str(style.band),
+                          classificationMin=lo, classificationMax=hi, opacity="1", alphaBand="-1")
+        ET.SubElement(r, "rasterTransparency")
+        shader = ET.SubElement(ET.SubElement(r, "rastershader"), "colorrampshader", colorRampType="INTERPOLATED",
+                               classificationMode="1", clip="0", minimumValue=lo, maximumValue=hi)
+        for x in np.linspace(0.0, 1.0, 17):
+            v = style.vmin + x * (style.vmax - style.vmin)
+            rgb = "#{:02x}{:02x}{:02x}".format(*(int(round(255 * c)) for c in cmap(float(x))[:3]))
+            ET.SubElement(shader, "item", value=f"{v:.6g}", color=rgb, alpha="255", label=f"{v:.4g}")
+    ET.SubElement(pipe, "brightnesscontrast", brightness="0", contrast="0")
+    ET.SubElement(pipe, "rasterresampler", maxOversampling="2")
+    ET.SubElement(root, "blendMode").text = "0"
+    if style.label:
+        ET.SubElement(root, "layerComment").text = style.label  # not read by QGIS: a note for people
+    ET.indent(root)
+    with atomic_path(path, ".qml") as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write("<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n")
+            fh.write(ET.tostring(root, encoding="unicode"))
+            fh.write("\n")
+
+
+def db_stretch(db: np.ndarray, low_pct: float = 2.0, high_pct: float = 99.5) -> tuple[float, float]:
+    """A readable grey stretch of a dB image: its ``low_pct`` and ``high_pct`` percentiles of the finite
+    pixels, at least 10 dB apart ((-30, 0) dB for an image without finite pixels)."""
+    v = np.asarray(db, np.float64)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return -30.0, 0.0
+    lo, hi = (float(x) for x in np.percentile(v, [low_pct, high_pct]))
+    return min(lo, hi - 10.0), hi
+
+
+def amplitude_db(image: np.ndarray, floor_db: float | None = -300.0) -> np.ndarray:
+    """20*log10|image| (float32): zero amplitude gives ``floor_db``, or NaN (no signal) with
+    ``floor_db=None``; NaN stays NaN."""
     a = np.abs(np.asarray(image)).astype(np.float64)
     with np.errstate(divide="ignore"):
         out = 20.0 * np.log10(a)
-    return np.maximum(out, floor_db).astype(np.float32)
+    out[np.isneginf(out)] = np.nan if floor_db is None else floor_db
+    if floor_db is not None:
+        out = np.where(np.isnan(out), out, np.maximum(out, floor_db))
+    return out.astype(np.float32)
 
 
 def write_quicklook(
@@ -116,6 +434,46 @@ def write_quicklook(
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     fig.colorbar(im, ax=ax, label=colorbar_label)
+    fig.tight_layout()
+    with atomic_path(path, ".png") as tmp:
+        fig.savefig(tmp, format="png")
+    plt.close(fig)
+
+
+def phase_rgb(phase: np.ndarray, brightness: np.ndarray) -> np.ndarray:
+    """RGBA (float, [0, 1]) of a phase picture: hue = phase (once round the colour wheel over 2 pi: cyan
+    at 0, red at +-pi, as matplotlib's ``hsv`` map over [-pi, pi]), full saturation, value =
+    ``brightness`` clipped to [0, 1]; NaN in either is transparent."""
+    from matplotlib.colors import hsv_to_rgb
+
+    ph = np.asarray(phase, np.float64)
+    br = np.asarray(brightness, np.float64)
+    ok = np.isfinite(ph) & np.isfinite(br)
+    hsv = np.stack([np.mod(np.where(ok, ph, 0.0) + np.pi, 2 * np.pi) / (2 * np.pi), np.ones_like(ph),
+                    np.clip(np.where(ok, br, 0.0), 0.0, 1.0)], axis=-1)
+    return np.concatenate([hsv_to_rgb(hsv), ok[..., None].astype(np.float64)], axis=-1)
+
+
+def write_phase_picture(path: str | os.PathLike, phase: np.ndarray, brightness: np.ndarray, title: str = "",
+                        brightness_label: str = "coherence", extent: Sequence[float] | None = None,
+                        xlabel: str = "", ylabel: str = "", aspect: str | float = "auto") -> None:
+    """A PNG of a phase (rad) with hue = phase and brightness = ``brightness`` in [0, 1] (coherence, or
+    a normalised amplitude): :func:`phase_rgb`, a cyclic hue bar for the phase, the brightness named."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    fig, ax = plt.subplots(figsize=(8, 6), dpi=100)
+    ax.imshow(phase_rgb(phase, brightness), extent=extent, aspect=aspect, interpolation="nearest", origin="upper")
+    ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    sm = ScalarMappable(Normalize(-np.pi, np.pi), cmap="hsv")
+    cb = fig.colorbar(sm, ax=ax, label=f"phase (rad); brightness: {brightness_label} (dark = 0)")
+    cb.set_ticks([-np.pi, -np.pi / 2, 0, np.pi / 2, np.pi], labels=["-π", "-π/2", "0", "π/2", "π"])
     fig.tight_layout()
     with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")

@@ -1,14 +1,17 @@
 """GB-SAR interferometry products.
 
-``gbsar_interferogram`` (schema 1)::
+``gbsar_interferogram`` (schema 2; schema 1 had no unwrapping: its ``value`` came from the WRAPPED residual)::
 
     /                 provenance, mode, pol, value_name, value_unit, rate (JSON), rail heights, frequencies
     /phase            float32 (n_range, n_azimuth) rad, raw phase of B * conj(A)
     /coherence        float32, boxcar sample coherence (window in the attributes)
     /model_phase      float32 rad, flat-surface model phase of the mode
     /residual_phase   float32 rad, wrapped phase after removing the model (NaN where undefined)
-    /value            float32, converted residual: LOS displacement (mm) | height (m) | range offset (m),
-                      NaN where the coherence is below the ``min_coherence`` attribute
+    /unwrapped_phase  float32 rad, residual unwrapped spatially (root attr ``unwrap_method``: SNAPHU),
+                      NaN outside its connected components
+    /connected_component  int32, SNAPHU's connected component of each pixel (0: none)
+    /value            float32, converted unwrapped residual: LOS displacement (mm) | height (m) | range
+                      offset (m), NaN where the coherence is below the ``min_coherence`` attribute
     phase, coherence, residual_phase and value are NaN outside the common support of the two images
     (outside the beam footprint or not covered by the focusing algorithm).
     /range, /azimuth  float64 axes (m), as the input images
@@ -38,6 +41,7 @@ from sarcli.io.h5common import (
     attr_json,
     attr_number,
     attr_str,
+    coordinate,
     dataset,
     group,
     open_product,
@@ -46,22 +50,41 @@ from sarcli.io.h5common import (
 from sarcli.model import checks as ck
 
 IFG_TYPE, PS_TYPE, SCHEMA_VERSION = "gbsar_interferogram", "gbsar_ps", "1"
+IFG_SCHEMA_VERSION = "2"
+
+
+_IFG_DESCRIPTIONS = {
+    "phase": "raw interferometric phase arg(B conj(A))", "coherence": "boxcar sample coherence",
+    "model_phase": "flat-surface model phase of the mode", "residual_phase": "phase minus the model, wrapped",
+    "unwrapped_phase": "residual phase unwrapped spatially (SNAPHU), NaN outside its connected components",
+    "connected_component": "SNAPHU connected component of each pixel (0: none)"}
+
+
+def _write_axes(f, range_m: np.ndarray, azimuth_m: np.ndarray):
+    return (coordinate(f, "range", np.asarray(range_m, np.float64), "m", "R0, distance from the rail line"),
+            coordinate(f, "azimuth", np.asarray(azimuth_m, np.float64), "m", "x along the rail"))
 
 
 def write_interferogram(path: str | os.PathLike, ifg, range_m: np.ndarray, azimuth_m: np.ndarray, attrs: dict,
                         parameters: dict | None = None, inputs: tuple = ()) -> None:
-    with atomic_h5(path, IFG_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
+    with atomic_h5(path, IFG_TYPE, IFG_SCHEMA_VERSION, parameters, inputs) as f:
         for k, v in attrs.items():
             f.attrs[k] = v
         f.attrs["value_name"] = ifg.value_name
         f.attrs["value_unit"] = ifg.value_unit
         f.attrs["rate"] = json.dumps(ifg.rate, default=float)
+        f.attrs["unwrap_method"] = ifg.unwrap_method
+        dims = _write_axes(f, range_m, azimuth_m)
         for name, arr, unit in (("phase", ifg.phase, "rad"), ("coherence", ifg.coherence, "1"),
                                 ("model_phase", ifg.model_phase, "rad"), ("residual_phase", ifg.residual, "rad"),
-                                ("value", ifg.value, ifg.value_unit)):
-            dataset(f, name, np.asarray(arr, np.float32), units=unit, compression="gzip")
-        dataset(f, "range", np.asarray(range_m, np.float64), units="m")
-        dataset(f, "azimuth", np.asarray(azimuth_m, np.float64), units="m")
+                                ("unwrapped_phase", ifg.unwrapped, "rad")):
+            dataset(f, name, np.asarray(arr, np.float32), units=unit, compression="gzip",
+                    description=_IFG_DESCRIPTIONS[name], dims=dims)
+        dataset(f, "connected_component", np.asarray(ifg.component, np.int32), units="1", compression="gzip",
+                description=_IFG_DESCRIPTIONS["connected_component"], dims=dims)
+        dataset(f, "value", np.asarray(ifg.value, np.float32), units=ifg.value_unit, compression="gzip",
+                description=f"{ifg.value_name.replace('_', ' ')} from the unwrapped residual, NaN below min_coherence",
+                dims=dims)
 
 
 def _root_attrs(f: h5py.File) -> dict[str, Any]:
@@ -115,18 +138,25 @@ def write_ps(path: str | os.PathLike, coherence: np.ndarray, time_s: np.ndarray,
     with atomic_h5(path, PS_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
         for k, v in attrs.items():
             f.attrs[k] = v
-        dataset(f, "coherence", np.asarray(coherence, np.float32), units="1", compression="gzip")
-        dataset(f, "time_s", np.asarray(time_s, np.float64), units="s")
-        dataset(f, "range", np.asarray(range_m, np.float64), units="m")
-        dataset(f, "azimuth", np.asarray(azimuth_m, np.float64), units="m")
+        rg, az = _write_axes(f, range_m, azimuth_m)
+        dataset(f, "coherence", np.asarray(coherence, np.float32), units="1", compression="gzip",
+                description="temporal coherence |sum z_i| / sum |z_i|", dims=(rg, az))
+        ts = coordinate(f, "time_s", np.asarray(time_s, np.float64), "s", "mean scan time after the reference "
+                        "scan's epoch")
+        sc = coordinate(f, "scatterer", np.arange(len(rows), dtype=np.int64), "1", "persistent scatterer index")
         g = group(f, "ps")
-        dataset(g, "row", np.asarray(rows, np.int64))
-        dataset(g, "col", np.asarray(cols, np.int64))
-        dataset(g, "range", np.asarray(range_m[rows], np.float64), units="m")
-        dataset(g, "azimuth", np.asarray(azimuth_m[cols], np.float64), units="m")
-        dataset(g, "coherence", np.asarray(coherence[rows, cols], np.float32), units="1")
-        dataset(g, "phase", np.asarray(phase, np.float32), units="rad")
-        dataset(g, "displacement_mm", np.asarray(displacement_mm, np.float32), units="mm")
+        g.attrs["description"] = "persistent scatterers: one row per scatterer"
+        for name, arr, unit, desc in (
+                ("row", np.asarray(rows, np.int64), "1", "pixel row"), ("col", np.asarray(cols, np.int64), "1",
+                                                                       "pixel column"),
+                ("range", np.asarray(range_m[rows], np.float64), "m", "R0 of the scatterer"),
+                ("azimuth", np.asarray(azimuth_m[cols], np.float64), "m", "x of the scatterer"),
+                ("coherence", np.asarray(coherence[rows, cols], np.float32), "1", "temporal coherence")):
+            dataset(g, name, arr, units=unit, description=desc, dims=(sc,))
+        dataset(g, "phase", np.asarray(phase, np.float32), units="rad", description="phase relative to the first "
+                "scan", dims=(sc, ts))
+        dataset(g, "displacement_mm", np.asarray(displacement_mm, np.float32), units="mm",
+                description="LOS displacement (+ away from the radar)", dims=(sc, ts))
 
 
 def read_ps(path: str | os.PathLike) -> dict:

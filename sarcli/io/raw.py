@@ -52,30 +52,75 @@ from sarcli.io.h5common import (
     atomic_h5,
     attr_number,
     attr_str,
+    cf_time_units,
+    coordinate,
     dataset,
     group,
     open_product,
     read_array,
     read_mapping,
     require,
+    units_from_name,
     write_mapping,
 )
 from sarcli.model import checks as ck
+from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import QUANTIZATION_BITS, Attitude, Orbit, Radar, RawProduct
 
 PRODUCT_TYPE = "raw"
 SCHEMA_VERSION = "1"
 
 
+#: HDF5 compression of the echo: ``auto`` (shuffle + gzip level 1 where it pays, :func:`echo_compression`),
+#: ``gzip`` (shuffle + gzip level 1), ``lzf`` (shuffle + lzf), ``none``
+COMPRESSIONS = ("auto", "gzip", "lzf", "none")
+#: bytes of one echo chunk: whole lines (the readers read line blocks across the full swath)
+CHUNK_BYTES = 1 << 20
+#: deflate level of ``gzip``: level 1 (measured: within 2 % of level 4's size at half its write time)
+GZIP_LEVEL = 1
+
+
+def echo_chunks(shape: tuple[int, ...]) -> tuple[int, ...]:
+    """Chunks of an echo array (..., n_lines, n_samples): whole lines, about :data:`CHUNK_BYTES` each
+    (complex64), since every reader reads blocks of lines across the whole swath."""
+    n_lines, n_samples = shape[-2:]
+    lines = int(min(max(n_lines, 1), max(1, CHUNK_BYTES // (8 * max(n_samples, 1)))))
+    return (1,) * (len(shape) - 2) + (lines, max(n_samples, 1))
+
+
+def echo_compression(echo: np.ndarray, compression: str | None = "auto") -> str | None:
+    """The h5py filter of the echo (``gzip`` or ``lzf``, always after the byte shuffle) or None.
+
+    ``auto`` compresses when it pays: the first chunk of lines, byte-shuffled as HDF5 does it and
+    deflated at level 1 with zlib, shrinks below 80 % (quantized echoes: RS-1's 4-bit levels, BAQ,
+    a simulation with the quantization effect, zero padding); a float echo of noise does not, and is
+    stored as it is (bench/bench_products.py measures sizes and costs)."""
+    import zlib
+
+    mode = "auto" if compression is None else compression
+    if mode not in COMPRESSIONS:
+        raise ProductError(f"unknown echo compression {compression!r} (use {', '.join(COMPRESSIONS)})")
+    if mode == "none":
+        return None
+    if mode != "auto":
+        return mode
+    e = np.asarray(echo)
+    rows = e.reshape(-1, e.shape[-1])[: echo_chunks(e.shape)[-2]]
+    raw = np.ascontiguousarray(rows, dtype=np.complex64).view(np.uint8).reshape(-1, 8).T.tobytes()
+    return "gzip" if raw and len(zlib.compress(raw, 1)) < 0.8 * len(raw) else None
+
+
 def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = None,
-              inputs: tuple = (), compression: str | None = None) -> None:
-    """Validate (:meth:`RawProduct.validate`) and write ``p`` atomically to ``path``.
+              inputs: tuple = (), compression: str | None = "auto") -> None:
+    """Validate (:meth:`RawProduct.validate`) and write ``p`` atomically to ``path`` (``compression``: one
+    of :data:`COMPRESSIONS`, None = ``auto``).
 
     NaN or inf samples are written as given (a tool may store them on purpose); :func:`read_raw`
     refuses them."""
     p.validate(str(path), finite_samples=False)
     n_lines, n_samples = p.echo.shape
-    chunks = (min(n_lines, 256), min(n_samples, 2048))
+    filt = echo_compression(p.echo, compression)
+    tunits = cf_time_units(p.epoch_utc)
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters, inputs) as f:
         f.attrs["epoch_utc"] = p.epoch_utc
         f.attrs["look_side"] = p.look_side
@@ -83,27 +128,39 @@ def write_raw(path: str | os.PathLike, p: RawProduct, parameters: dict | None = 
         f.attrs["n_channels"] = p.n_channels
         for k, v in sorted(p.extra_attrs.items()):
             f.attrs[k] = v
+        t = coordinate(f, "azimuth_time", np.asarray(p.azimuth_time, dtype=np.float64), tunits,
+                       "pulse transmit time of each echo line")
+        fs, tau0 = p.radar.range_sampling_rate_hz, p.radar.window_start_s
+        r = coordinate(f, "slant_range", C_LIGHT / 2.0 * (tau0 + np.arange(n_samples) / fs), "m",
+                       "one-way range c*tau/2 of each echo sample's two-way delay tau (window_start_s + k/fs)")
         dataset(f, "echo", np.asarray(p.echo, dtype=np.complex64), units="1",
-                description="raw echo samples, channel 0, (azimuth line, range sample)",
-                chunks=chunks, compression=compression)
+                       description="raw echo samples, channel 0, (azimuth line, range sample), as delivered",
+                       chunks=echo_chunks(p.echo.shape), compression=filt, level=GZIP_LEVEL, dims=(t, r))
         if p.echo_channels is not None:
+            ch = coordinate(f, "channel", np.arange(1, p.n_channels, dtype=np.int32), "1",
+                            "receive channel index (0 is /echo)")
             dataset(f, "echo_channels", np.asarray(p.echo_channels, dtype=np.complex64), units="1",
-                    description="further receive channels", chunks=(1, *chunks), compression=compression)
-        dataset(f, "azimuth_time", np.asarray(p.azimuth_time, dtype=np.float64), units="s",
-                description="pulse transmit time after epoch_utc")
+                    description="further receive channels (channel, azimuth line, range sample)",
+                    chunks=echo_chunks(p.echo_channels.shape), compression=filt, level=GZIP_LEVEL,
+                    dims=(ch, t, r))
         g = write_radar(f, p.radar)
         if p.prf_per_line is not None:
-            dataset(g, "prf_per_line", np.asarray(p.prf_per_line, np.float64), units="Hz")
+            dataset(g, "prf_per_line", np.asarray(p.prf_per_line, np.float64), units="Hz",
+                    description="pulse repetition frequency of each line", dims=(t,))
         if p.agc_db is not None:
             dataset(g, "agc_db", np.asarray(p.agc_db, np.float32), units="dB",
-                    description="receiver attenuation per line; multiply by 10**(agc_db/20) to undo")
+                    description="receiver attenuation per line; multiply by 10**(agc_db/20) to undo", dims=(t,))
         if p.replica is not None:
-            dataset(g, "replica", np.asarray(p.replica, np.complex64), units="1")
-        write_platform(f, p.orbit, p.attitude)
+            rt = coordinate(g, "replica_time", np.arange(p.replica.size) / fs, "s",
+                            "time of each replica sample from the replica's first sample")
+            dataset(g, "replica", np.asarray(p.replica, np.complex64), units="1",
+                    description="chirp replica at the range sampling rate", dims=(rt,))
+        write_platform(f, p.orbit, p.attitude, p.epoch_utc)
         for name, arr in sorted(p.auxiliary.items()):
-            f.create_dataset(f"auxiliary/{name}", data=arr)
+            dataset(f, f"auxiliary/{name}", arr, units=units_from_name(name.rsplit("/", 1)[-1]) or "1",
+                    description=f"auxiliary array kept by the {p.source} reader (not focused)")
         if p.truth is not None:
-            write_mapping(f, "truth", p.truth)
+            write_mapping(f, "truth", p.truth, p.epoch_utc)
 
 
 def write_radar(f: h5py.Group, radar: Radar) -> h5py.Group:
@@ -137,19 +194,49 @@ def read_radar(g: h5py.Group, path: str | os.PathLike) -> Radar:
     return Radar(**kw)
 
 
-def write_platform(f: h5py.Group, orbit: Orbit | None, attitude: Attitude | None) -> None:
-    """/orbit and /attitude groups (shared by the raw and SLC products)."""
+def write_platform(f: h5py.Group, orbit: Orbit | None, attitude: Attitude | None, epoch_utc: str) -> None:
+    """/orbit and /attitude groups (shared by the raw and SLC products), and for an Earth orbit (ECI or
+    ECEF) /orbit_ecef: the same state vectors in WGS-84 ECEF (GMST rotation, ``orbit.frames``), laid
+    out as ISCE3 loads an orbit group (``time`` with ``seconds since`` units, ``position``,
+    ``velocity``, ``orbitType``, ``interpMethod``)."""
+    from orbit.errors import OrbitError
+    from orbit.statevectors import StateVectors
+
+    tunits = cf_time_units(epoch_utc)
     if orbit is not None:
         og = group(f, "orbit")
         og.attrs["frame"] = orbit.frame
-        dataset(og, "time", np.asarray(orbit.time, np.float64), units="s")
-        dataset(og, "position", np.asarray(orbit.position, np.float64), units="m")
-        dataset(og, "velocity", np.asarray(orbit.velocity, np.float64), units="m/s")
+        og.attrs["description"] = f"platform state vectors as delivered, {orbit.frame} frame"
+        t = coordinate(og, "time", np.asarray(orbit.time, np.float64), tunits, "time of each state vector")
+        xyz = coordinate(og, "xyz", np.array([b"x", b"y", b"z"]), "1", "Cartesian component")
+        dataset(og, "position", np.asarray(orbit.position, np.float64), units="m",
+                description=f"platform position ({orbit.frame})", dims=(t, xyz))
+        dataset(og, "velocity", np.asarray(orbit.velocity, np.float64), units="m/s",
+                description=f"platform velocity ({orbit.frame})", dims=(t, xyz))
+        if orbit.frame in ("ECI", "ECEF"):
+            try:
+                sv = StateVectors.from_record(orbit, epoch_utc).to_ecef()
+            except OrbitError as e:
+                raise ProductError(f"orbit: {e}") from None
+            eg = group(f, "orbit_ecef")
+            eg.attrs["frame"] = "ECEF"
+            eg.attrs["description"] = ("the state vectors of /orbit in WGS-84 ECEF (ISCE3/NISAR orbit layout); "
+                                       f"{'rotated from ECI of date by GMST' if orbit.frame == 'ECI' else 'a copy'}")
+            et = coordinate(eg, "time", sv.time, tunits, "time of each state vector")
+            exyz = coordinate(eg, "xyz", np.array([b"x", b"y", b"z"]), "1", "Cartesian component")
+            dataset(eg, "position", sv.position, units="m", description="platform position (ECEF, WGS-84)",
+                    dims=(et, exyz))
+            dataset(eg, "velocity", sv.velocity, units="m/s", description="platform velocity (ECEF, WGS-84)",
+                    dims=(et, exyz))
+            dataset(eg, "orbitType", np.bytes_("Custom"), units="1", description="orbit product type (ISCE3)")
+            dataset(eg, "interpMethod", np.bytes_("Hermite"), units="1", description="interpolation method (ISCE3)")
     if attitude is not None:
         ag = group(f, "attitude")
-        dataset(ag, "time", np.asarray(attitude.time, np.float64), units="s")
+        ag.attrs["description"] = "platform attitude: total flight-frame pitch, roll, yaw (orbit.pointing)"
+        t = coordinate(ag, "time", np.asarray(attitude.time, np.float64), tunits, "time of each attitude record")
         for name in ("pitch", "roll", "yaw"):
-            dataset(ag, name, np.asarray(getattr(attitude, name), np.float64), units="rad")
+            dataset(ag, name, np.asarray(getattr(attitude, name), np.float64), units="rad",
+                    description=f"{name} angle", dims=(t,))
 
 
 def read_platform(f: h5py.Group, path: str | os.PathLike) -> tuple[Orbit | None, Attitude | None]:
@@ -238,7 +325,8 @@ def read_raw(path: str | os.PathLike, load_echo: bool = True) -> RawProduct:
         n_ch = attr_number(f, "n_channels", p.n_channels, lo=1, integer=True)
         if n_ch != p.n_channels:
             raise ProductError(f"{path}: n_channels says {n_ch}, the product holds {p.n_channels} channel(s)")
-        p.extra_attrs = _extra_attrs(f, set(PROVENANCE_ATTRS) | {"epoch_utc", "look_side", "source", "n_channels"},
+        p.extra_attrs = _extra_attrs(f, set(PROVENANCE_ATTRS) | {"Conventions", "epoch_utc", "look_side", "source",
+                                                                    "n_channels"},
                                      path)
         p.validate(str(path), n_samples=n_samples)  # everything but the samples, before reading them
         if load_echo:

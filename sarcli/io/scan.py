@@ -52,6 +52,8 @@ from sarcli.io.h5common import (
     atomic_h5,
     attr_number,
     attr_str,
+    cf_time_units,
+    coordinate,
     dataset,
     group,
     open_product,
@@ -68,11 +70,20 @@ SCHEMA_VERSION_TRACK = "2"  # with antenna_position and/or reference_range
 __all__ = ["POLARIZATIONS", "PRODUCT_TYPE", "ScanWriter", "read_attr_group", "read_scan", "write_scan"]
 
 
-def _write_static(f: h5py.File, s: Scan) -> None:
+_DESCRIPTIONS = {"s21": "S21 per polarization, rail stop, frequency",
+                 "rail_height": "antenna phase-centre height above the reference (z)",
+                 "stop_time": "start of each stop's sweeps",
+                 "stop_flags": "0 good, 1 invalid sweep (skipped by focusing)"}
+
+
+def _write_static(f: h5py.File, s: Scan) -> tuple[h5py.Dataset, h5py.Dataset]:
+    """Root attributes, groups and the fixed axes; returns the (polarization, frequency) coordinates."""
     f.attrs["epoch_utc"] = s.epoch_utc
     f.attrs["polarizations"] = ",".join(s.polarizations)
     f.attrs["source"] = s.source
-    dataset(f, "frequency", np.asarray(s.frequency, np.float64), units="Hz")
+    freq = coordinate(f, "frequency", np.asarray(s.frequency, np.float64), "Hz", "sweep frequency")
+    pol = coordinate(f, "polarization", np.array([p.encode() for p in s.polarizations]), "1",
+                     "transmit-receive polarization")
     for name, obj in (("site", s.site), ("antenna", s.antenna)):
         g = group(f, name)
         for k, v in vars(obj).items():
@@ -81,7 +92,36 @@ def _write_static(f: h5py.File, s: Scan) -> None:
     for k, v in sorted(s.instrument.items()):
         g.attrs[k] = v
     if s.truth is not None:
-        write_mapping(f, "truth", s.truth)
+        write_mapping(f, "truth", s.truth, s.epoch_utc)
+    return pol, freq
+
+
+def _stop_axes(f: h5py.File, s: Scan | None, n: int, pol: h5py.Dataset, freq: h5py.Dataset,
+               resizable: bool) -> None:
+    """/rail_position (the stop axis' coordinate), /s21 and the per-stop datasets (empty and
+    resizable for a scan measured stop by stop)."""
+    epoch = attr_str(f, "epoch_utc")
+    tunits = cf_time_units(epoch) if epoch else "s"
+    grow = {"chunks": (256,), "maxshape": (None,)} if resizable else {}
+    zero = np.zeros(0)
+    rp = coordinate(f, "rail_position", zero if s is None else np.asarray(s.rail_position, np.float64), "m",
+                    "along-rail position of each stop (x)", **grow)
+    n_pol, n_freq = pol.shape[0], freq.shape[0]
+    s21 = np.zeros((n_pol, 0, n_freq), np.complex64) if s is None else np.asarray(s.s21, np.complex64)
+    dataset(f, "s21", s21, units="1", description=_DESCRIPTIONS["s21"], dims=(pol, rp, freq),
+            **({"chunks": (n_pol, 1, n_freq), "maxshape": (n_pol, None, n_freq)} if resizable else {}))
+    st = np.zeros(n) if s is None or s.stop_time is None else s.stop_time
+    fl = np.zeros(n, np.uint8) if s is None or s.stop_flags is None else s.stop_flags
+    for name, arr, dt, unit in (("rail_height", zero if s is None else s.rail_height, np.float64, "m"),
+                                ("stop_time", st, np.float64, tunits), ("stop_flags", fl, np.uint8, "1")):
+        dataset(f, name, np.asarray(arr, dt), units=unit, description=_DESCRIPTIONS[name], dims=(rp,), **grow)
+    if s is not None and s.antenna_position is not None:
+        xyz = coordinate(f, "xyz", np.array([b"x", b"y", b"z"]), "1", "Cartesian component")
+        dataset(f, "antenna_position", np.asarray(s.antenna_position, np.float64), units="m",
+                description="antenna phase centre (x, y, z) of each sweep, local Cartesian frame", dims=(rp, xyz))
+    if s is not None and s.reference_range is not None:
+        dataset(f, "reference_range", np.asarray(s.reference_range, np.float64), units="m",
+                description="range each sweep's phase is referenced to", dims=(rp,))
 
 
 def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None, inputs: tuple = ()) -> None:
@@ -90,21 +130,11 @@ def write_scan(path: str | os.PathLike, s: Scan, parameters: dict | None = None,
     n_stops = s.n_stops
     version = SCHEMA_VERSION if s.is_rail else SCHEMA_VERSION_TRACK
     with atomic_h5(path, PRODUCT_TYPE, version, parameters, inputs) as f:
-        _write_static(f, s)
+        pol, freq = _write_static(f, s)
         f.attrs["n_planned"] = s.n_planned if s.n_planned is not None else n_stops
         f.attrs["n_complete"] = n_stops
         f.attrs["status"] = s.status
-        dataset(f, "s21", np.asarray(s.s21, np.complex64), units="1")
-        dataset(f, "rail_position", np.asarray(s.rail_position, np.float64), units="m")
-        dataset(f, "rail_height", np.asarray(s.rail_height, np.float64), units="m")
-        st = s.stop_time if s.stop_time is not None else np.zeros(n_stops)
-        dataset(f, "stop_time", np.asarray(st, np.float64), units="s")
-        fl = s.stop_flags if s.stop_flags is not None else np.zeros(n_stops, np.uint8)
-        dataset(f, "stop_flags", np.asarray(fl, np.uint8), units="1")
-        if s.antenna_position is not None:
-            dataset(f, "antenna_position", np.asarray(s.antenna_position, np.float64), units="m")
-        if s.reference_range is not None:
-            dataset(f, "reference_range", np.asarray(s.reference_range, np.float64), units="m")
+        _stop_axes(f, s, n_stops, pol, freq, resizable=False)
 
 
 def read_attr_group(f: h5py.Group, name: str, cls: type) -> Any:
@@ -195,17 +225,12 @@ class ScanWriter:
     def create(cls, path: str | os.PathLike, template: Scan, n_planned: int,
                parameters: dict | None = None) -> ScanWriter:
         """Create an empty, valid scan file for ``n_planned`` stops (template gives frequency, pols...)."""
-        n_pol, n_freq = len(template.polarizations), template.frequency.shape[0]
         with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, parameters) as f:
-            _write_static(f, template)
+            pol, freq = _write_static(f, template)
             f.attrs["n_planned"] = n_planned
             f.attrs["n_complete"] = 0
             f.attrs["status"] = "interrupted"
-            dataset(f, "s21", np.zeros((n_pol, 0, n_freq), np.complex64), units="1",
-                    chunks=(n_pol, 1, n_freq), maxshape=(n_pol, None, n_freq))
-            for name, dt, unit in (("rail_position", np.float64, "m"), ("rail_height", np.float64, "m"),
-                                   ("stop_time", np.float64, "s"), ("stop_flags", np.uint8, "1")):
-                dataset(f, name, np.zeros(0, dt), units=unit, chunks=(256,), maxshape=(None,))
+            _stop_axes(f, None, 0, pol, freq, resizable=True)
         return cls(path)
 
     @classmethod

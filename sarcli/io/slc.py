@@ -14,9 +14,15 @@ Layout (SI units)::
                            (raw time at which the model was evaluated), range_m (n_samples,),
                            fdc_hz, fr_hz_per_s, velocity_mps (n_blocks, n_samples)
     /radar                 the raw product's radar attributes
-    /orbit, /attitude      copied from the raw product when present (geolocation)
+    /orbit, /attitude      copied from the raw product when present (geolocation); /orbit_ecef the
+                           orbit in WGS-84 ECEF (:func:`sarcli.io.raw.write_platform`)
+    /geolocation_grid      Earth orbits only: longitude, latitude, incidence_angle, look_angle (degrees) on
+                           (height, azimuth_time, slant_range) nodes; root ``bounding_polygon`` (WKT)
     /truth                 copied from a simulated raw product (``sarcli quality`` compares with it)
     /timings               attributes: seconds per processing stage
+
+Times are ``seconds since <epoch_utc>`` (CF); /image's axes are the dimension scales /azimuth_time and
+/slant_range, so ``xarray.open_dataset(path, engine="h5netcdf")`` labels it (docs/products.md).
 """
 
 from __future__ import annotations
@@ -32,9 +38,12 @@ import numpy as np
 from sarcli.errors import ProductError
 from sarcli.io.h5common import (
     atomic_h5,
+    attach,
     attr_json,
     attr_number,
     attr_str,
+    cf_time_units,
+    coordinate,
     dataset,
     group,
     open_product,
@@ -54,7 +63,64 @@ SCHEMA_VERSION = "1"
 AXIS_RTOL = 0.1  # zero-Doppler times and slant ranges are uniform grids: each step the mean step within 10 %
 
 
-def _write_meta(f: h5py.File, s: SLC) -> None:
+#: heights (m above the WGS-84 ellipsoid) of the geolocation grid's layers (NISAR's grid spans -500..9000 m)
+GRID_HEIGHTS_M = (-500.0, 0.0, 500.0, 1000.0, 2000.0, 4000.0, 9000.0)
+#: nodes of the geolocation grid along each image axis
+GRID_NODES = 11
+
+
+def recorded_height(parameters: dict | None) -> float:
+    """The terrain height an SLC was focused with (``parameters["terrain"]``: the constant height, or the
+    DEM's mean height), 0 m when it records none: a first-order height for quantities that depend
+    weakly on it (ground spacings, the bounding polygon)."""
+    t = parameters.get("terrain") if isinstance(parameters, dict) else None
+    if isinstance(t, dict):
+        for key in ("height_m", "mean_height_m"):
+            if isinstance(t.get(key), int | float) and np.isfinite(t[key]):
+                return float(t[key])
+    return 0.0
+
+
+def _write_geolocation(f: h5py.File, s: SLC, tunits: str) -> None:
+    """/geolocation_grid (longitude, latitude, incidence and look angles of the zero-Doppler target on
+    GRID_NODES x GRID_NODES image nodes at each of GRID_HEIGHTS_M, NISAR's layout) and the root
+    ``bounding_polygon`` (WKT POLYGON of lon lat h, the image perimeter at the focusing height). An
+    SLC without an Earth orbit (none, or LOCAL) gets neither; a geometry the solver cannot place
+    (e.g. a range that never reaches a layer) records why in ``geolocation_note``."""
+    from sarcli.io.nisar.rslc import _ecef_sv, _wkt_polygon, geolocation_cubes
+
+    if s.orbit is None or s.orbit.frame == "LOCAL" or s.azimuth_time.size < 2 or s.slant_range.size < 2:
+        f.attrs["geolocation_note"] = "no Earth orbit: no geolocation grid"
+        return
+    t = np.linspace(s.azimuth_time[0], s.azimuth_time[-1], GRID_NODES)
+    r = np.linspace(s.slant_range[0], s.slant_range[-1], GRID_NODES)
+    h = np.asarray(GRID_HEIGHTS_M)
+    lam = s.radar.wavelength_m
+    try:
+        sv = _ecef_sv(s)
+        cubes = geolocation_cubes(sv, t, r, h, lam, s.look_side)
+        polygon = _wkt_polygon(sv, s.azimuth_time, s.slant_range, lam, s.look_side, recorded_height(s.parameters))
+    except ProductError as e:
+        f.attrs["geolocation_note"] = f"no geolocation grid: {e}"
+        return
+    f.attrs["bounding_polygon"] = polygon
+    g = group(f, "geolocation_grid")
+    g.attrs["description"] = ("zero-Doppler geolocation of image nodes on the WGS-84 ellipsoid raised by each height "
+                              "(interpolate trilinearly in height, time, range)")
+    hh = coordinate(g, "height", h, "m", "height above the WGS-84 ellipsoid")
+    tt = coordinate(g, "azimuth_time", t, tunits, "zero-Doppler time of the grid nodes")
+    rr = coordinate(g, "slant_range", r, "m", "slant range of the grid nodes")
+    for name, key, units, desc in (("longitude", "coordinateX", "degree_east", "geodetic longitude (WGS-84)"),
+                                   ("latitude", "coordinateY", "degree_north", "geodetic latitude (WGS-84)"),
+                                   ("incidence_angle", "incidenceAngle", "degree",
+                                    "angle between the line of sight and the ellipsoid normal at the target"),
+                                   ("look_angle", "elevationAngle", "degree",
+                                    "angle between the line of sight and the ellipsoid normal at the sensor")):
+        dataset(g, name, np.asarray(cubes[key], np.float64), units=units, description=desc, dims=(hh, tt, rr))
+
+
+def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
+    tunits = cf_time_units(s.epoch_utc)
     f.attrs["parameters"] = json.dumps(to_jsonable(dict(s.parameters)), sort_keys=True)
     f.attrs["epoch_utc"] = s.epoch_utc
     f.attrs["look_side"] = s.look_side
@@ -65,43 +131,61 @@ def _write_meta(f: h5py.File, s: SLC) -> None:
     f.attrs["prf_hz"] = s.prf_hz
     f.attrs["first_full_line"] = int(s.first_full_line)
     f.attrs["last_full_line"] = int(s.last_full_line)
-    dataset(f, "azimuth_time", np.asarray(s.azimuth_time, np.float64), units="s",
-            description="zero-Doppler time after epoch_utc")
-    dataset(f, "slant_range", np.asarray(s.slant_range, np.float64), units="m",
-            description="closest-approach slant range")
+    t = coordinate(f, "azimuth_time", np.asarray(s.azimuth_time, np.float64), tunits,
+                   "zero-Doppler time of each image line")
+    r = coordinate(f, "slant_range", np.asarray(s.slant_range, np.float64), "m",
+                   "closest-approach slant range of each image column")
+    attach(image, t, r)
     g = group(f, "doppler")
+    g.attrs["description"] = "the Doppler used by the focuser, per processing block and range"
     d = s.doppler
-    dataset(g, "block_time", np.asarray(d.block_time, np.float64), units="s")
-    dataset(g, "range_m", np.asarray(d.range_m, np.float64), units="m")
-    dataset(g, "fdc_hz", np.asarray(d.fdc_hz, np.float64), units="Hz")
-    dataset(g, "fr_hz_per_s", np.asarray(d.fr_hz_per_s, np.float64), units="Hz/s")
-    dataset(g, "velocity_mps", np.asarray(d.velocity_mps, np.float64), units="m/s")
+    bt = coordinate(g, "block_time", np.asarray(d.block_time, np.float64), tunits,
+                    "raw time at which the block's Doppler model was evaluated")
+    rg = coordinate(g, "range_m", np.asarray(d.range_m, np.float64), "m", "slant range")
+    for name, units, desc in (("fdc_hz", "Hz", "Doppler centroid used"), ("fr_hz_per_s", "Hz/s", "Doppler rate used"),
+                              ("velocity_mps", "m/s", "effective velocity used")):
+        dataset(g, name, np.asarray(getattr(d, name), np.float64), units=units, description=desc, dims=(bt, rg))
     write_radar(f, s.radar)
-    write_platform(f, s.orbit, s.attitude)
+    write_platform(f, s.orbit, s.attitude, s.epoch_utc)
+    _write_geolocation(f, s, tunits)
     if s.truth is not None:
-        write_mapping(f, "truth", s.truth)
+        write_mapping(f, "truth", s.truth, s.epoch_utc)
     tg = group(f, "timings")
     for k, v in sorted(s.timings.items()):
         tg.attrs[k] = float(v)
 
 
+#: bytes of one ``/image`` chunk at most (HDF5's default chunk cache is 1 MiB: a chunk that a block
+#: boundary splits stays in the cache until the next block completes it)
+CHUNK_BYTES = 1 << 20
+
+
+def image_chunks(shape: tuple[int, int]) -> tuple[int, int]:
+    """HDF5 chunks of ``/image``: whole lines (no padding of the line to a multiple of a chunk width: a
+    6354-sample line in 2048-wide chunks stored 29 % of padding), as many as fit in :data:`CHUNK_BYTES`."""
+    n, m = (max(1, int(v)) for v in shape)
+    return min(n, max(1, CHUNK_BYTES // (8 * m))), m
+
+
 @contextlib.contextmanager
 def slc_writer(path: str | os.PathLike, meta: SLC, shape: tuple[int, int], inputs: tuple = (),
                compression: str | None = None) -> Iterator[h5py.Dataset]:
-    """Create the product atomically and yield the empty ``/image`` dataset to fill block by block.
+    """Create the product atomically and yield the empty ``/image`` dataset to fill block by block
+    (rows in any order).
 
     ``meta`` carries everything but the image (its ``image`` may be empty); metadata that is only
     known after processing (axes, Doppler, timings, parameters) can be set on ``meta`` inside the
-    block (:meth:`SLC.update_from`): it is written when the block exits.
+    block (:meth:`SLC.update_from`): it is written when the block exits. The inputs are hashed
+    meanwhile (:func:`sarcli.io.h5common.atomic_h5`).
     """
-    chunks = (min(shape[0], 256), min(shape[1], 2048))
+    chunks = image_chunks(shape)
     with atomic_h5(path, PRODUCT_TYPE, SCHEMA_VERSION, meta.parameters, inputs) as f:
         ds = f.create_dataset("image", shape=shape, dtype=np.complex64, chunks=chunks, track_times=False,
                               **({"compression": compression} if compression else {}))
         ds.attrs["units"] = "1"
         ds.attrs["description"] = "focused single-look complex image (zero-Doppler line, slant-range column)"
         yield ds
-        _write_meta(f, meta)
+        _write_meta(f, meta, ds)
 
 
 def write_slc(path: str | os.PathLike, s: SLC, inputs: tuple = ()) -> None:

@@ -152,7 +152,10 @@ class Scan:
             ck.array(where, "antenna_position", self.antenna_position, "f", shape=(n_stops, 3))
             ck.increasing(where, "rail_position (distance along the track)", x, strict=False)
         elif x.size > 1 and x[-1] < x[0]:
-            ck.increasing(where, "rail_position (a decreasing rail)", -x)
+            if not np.all(np.diff(x) < 0):
+                k = int(np.argmin(np.diff(x) < 0))
+                raise ProductError(f"{where}: rail_position must move one way: it decreases overall but element "
+                                   f"{k + 1} = {x[k + 1]:g} follows {x[k]:g}")
         else:
             ck.increasing(where, "rail_position", x)
         if self.reference_range is not None:

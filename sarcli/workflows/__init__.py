@@ -20,6 +20,7 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "ati_detect": "sarcli.workflows.ati_detect",
     "ati_estimate": "sarcli.workflows.ati_estimate",
     "ati_montecarlo": "sarcli.workflows.ati_montecarlo",
+    "batch": "sarcli.workflows.batch",
     "corner_reflectors": "sarcli.workflows.corner_reflectors",
     "design": "sarcli.workflows.design",
     "doppler": "sarcli.workflows.doppler",

@@ -85,7 +85,12 @@ def _pngs(folder: Path, pair: Any, res: Any, after: Any, conv: Any) -> list[Path
     half = max(res.rows.stop - res.rows.start, 120)
     rows = slice(max(0, min(res.rows.start, centre) - half // 2), min(n, max(res.rows.stop, centre) + half // 2))
     ext = [float(ranges[cols.start]), float(ranges[cols.stop - 1]), float(ys[rows.stop - 1]), float(ys[rows.start])]
-    kw = {"extent": ext, "xlabel": "slant range (m)", "ylabel": "azimuth y (m)", "dynamic_range_db": 40.0}
+    # one dB scale for before / after / conventional: white at the brightest pixel of any of them, 40 dB deep,
+    # so the focused mover is visibly brighter than its smeared self
+    top = max(float(np.max(np.abs(x[rows, cols]))) for x in (pair.z0, after, conv) if x is not None)
+    vmax = 20.0 * np.log10(max(top, np.finfo(np.float32).tiny))
+    kw = {"extent": ext, "xlabel": "slant range (m)", "ylabel": "azimuth y (m)", "vmin": vmax - 40.0, "vmax": vmax,
+          "colorbar_label": "amplitude (dB, one scale for every panel)"}
     written = [folder / f"mover{mid}_before.png", folder / f"mover{mid}_after.png"]
     write_quicklook(written[0], pair.z0[rows, cols], title="before compensation", **kw)
     write_quicklook(written[1], after[rows, cols], title="after compensation (proposed)", **kw)

@@ -117,7 +117,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         if config.plot is not None:
             from sarcli.doppler.plot import plot_doppler
 
-            plot_doppler(config.plot, model)
+            plot_doppler(config.plot, model, raw)  # the plot draws a simulated product's truth beside it
     for w in caught:  # the estimate's own warnings go to the report, any other is passed on
         if not issubclass(w.category, UserWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

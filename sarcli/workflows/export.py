@@ -4,8 +4,10 @@ Formats are plug-ins in :data:`FORMATS` (``Registry``, entry-point group ``sarcl
 object with ``name``, ``description``, ``suffix``, ``Options`` (a frozen dataclass, filled with
 :func:`sarcli.config.from_mapping` from ``Config.options``) and ``write(slc, output, options, inputs)``.
 Built in: ``nisar-rslc`` (:class:`NisarRslcFormat`, the NISAR L1 RSLC layout of
-``sarcli.io.nisar.rslc``). A SICD or ENVI writer is added by registering another such object; the
-command does not change.
+``sarcli.io.nisar.rslc``), ``sicd`` (NGA SICD 1.4 in NITF through sarkit,
+:mod:`sarcli.workflows.export_sicd`) and ``envi`` (ENVI complex image with GCP georeferencing,
+:mod:`sarcli.workflows.export_envi`). Another format is one more such object; the command does
+not change.
 
 ``write_format(slc, output, name, options, inputs)`` is the same step for an SLC in memory (``sarcli
 focus --format nisar-rslc``).
@@ -46,6 +48,8 @@ def _check(name: str, obj: Any) -> None:
 
 FORMATS: Registry[ExportFormat] = Registry("export format", "sarcli.export_formats", {
     "nisar-rslc": "sarcli.workflows.export:NISAR_RSLC",
+    "sicd": "sarcli.workflows.export_sicd:SICD",
+    "envi": "sarcli.workflows.export_envi:ENVI",
 }, check=_check)
 
 
@@ -73,6 +77,26 @@ def spectral_weighting(spec: str, band_hz: float, rate_hz: float, n: int = 256):
     return Weighting(window(spec, f / band_hz), name, shape)
 
 
+def processed_bands(slc: SLC, fmt: str) -> tuple[float, float, float]:
+    """(acquired range bandwidth, processed range bandwidth, processed azimuth bandwidth), Hz, from the
+    focusing parameters of a sarcli SLC or the RSLC it was read from (``parameters["nisar"]``); an SLC
+    that records neither is refused (one line) for the format ``fmt``."""
+    from sarcli.focus.rangecomp import chirp_band
+
+    p = slc.parameters or {}
+    nisar = p.get("nisar", {})
+    acquired = chirp_band(slc.radar) if np.isfinite(slc.radar.chirp_rate_hz_per_s * slc.radar.pulse_length_s) \
+        else float(nisar.get("acquired_range_bandwidth_hz", np.nan))
+    b_r = acquired * float(p.get("range_bandwidth_fraction", 1.0)) if "range_window" in p \
+        else float(nisar.get("processed_range_bandwidth_hz", acquired))
+    b_a = float(p.get("azimuth_bandwidth_hz", nisar.get("processed_azimuth_bandwidth_hz", np.nan)))
+    for what, v in (("range", b_r), ("azimuth", b_a)):
+        if not (np.isfinite(v) and v > 0):
+            raise ConfigError(f"the SLC does not record its processed {what} bandwidth: cannot describe it "
+                              f"in {fmt}")
+    return acquired, b_r, b_a
+
+
 class NisarRslcFormat:
     """The NISAR L1 RSLC layout (``sarcli.io.nisar.rslc.write_rslc``)."""
 
@@ -85,20 +109,11 @@ class NisarRslcFormat:
         """The RSLC metadata of an SLC: processed bands and weightings from its focusing parameters
         (a sarcli SLC) or from the RSLC it was read from (``parameters["nisar"]``)."""
         from sarcli.focus.geocode import recorded_height
-        from sarcli.focus.rangecomp import chirp_band
         from sarcli.io.nisar.rslc import RslcMeta
 
         p = slc.parameters or {}
         nisar = p.get("nisar", {})
-        acquired = chirp_band(slc.radar) if np.isfinite(slc.radar.chirp_rate_hz_per_s * slc.radar.pulse_length_s) \
-            else float(nisar.get("acquired_range_bandwidth_hz", np.nan))
-        b_r = acquired * float(p.get("range_bandwidth_fraction", 1.0)) if "range_window" in p \
-            else float(nisar.get("processed_range_bandwidth_hz", acquired))
-        b_a = float(p.get("azimuth_bandwidth_hz", nisar.get("processed_azimuth_bandwidth_hz", np.nan)))
-        for what, v in (("range", b_r), ("azimuth", b_a)):
-            if not (np.isfinite(v) and v > 0):
-                raise ConfigError(f"the SLC does not record its processed {what} bandwidth: cannot describe it "
-                                  "in an RSLC")
+        acquired, b_r, b_a = processed_bands(slc, "an RSLC")
         fs = slc.radar.range_sampling_rate_hz
         rw = spectral_weighting(p["range_window"], b_r, fs) if "range_window" in p else None
         aw = spectral_weighting(p["azimuth_window"], b_a, slc.prf_hz) if "azimuth_window" in p else None

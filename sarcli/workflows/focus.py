@@ -6,6 +6,11 @@ or estimated from the data when the focuser needs one), streaming the echo from 
 (or handing the echo in memory to a focuser that does not stream), writing the SLC atomically,
 image statistics, GeoTIFFs and the quicklook, and the report.
 
+One pass over the image: every focused block goes to a :class:`sarcli.focus.sink.BlockSink` that
+writes it, keeps its per-line statistics sums and the multilooked intensities of the GeoTIFFs and
+the quicklook; the inputs are hashed on a thread meanwhile. With ``workers`` or ``scheduler`` the
+blocks are Dask tasks (:mod:`sarcli.parallel.focus`): the same image, bit for bit.
+
 Refused before any work, in one line: an output that is an input (same file, symbolic or hard
 link), options out of range, a raw product marked not focusable (``focusable = False`` with its
 ``not_focusable_reason``, e.g. TOPS bursts), a Doppler model whose ambiguity is unresolved
@@ -42,7 +47,10 @@ class Config:
     height_m / dem / dem_geoid: the terrain (:func:`sarcli.io.dem.load_terrain`); geotiff (map
     projected, ``crs`` default UTM, ``pixel_spacing_m``), geotiff_slant, quicklook: optional products
     with looks_az x looks_rg looks; channel: receive channel (0 = /echo);
-    accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved.
+    accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved;
+    workers / threads_per_worker / scheduler: focus the blocks in parallel on a local Dask cluster of
+    that many processes, or on the scheduler at that address (:mod:`sarcli.parallel.cluster`); they
+    do not change the image and are not stored in the product.
     """
 
     raw: Path
@@ -64,8 +72,12 @@ class Config:
     looks_rg: int = 1
     channel: int = 0
     accept_unresolved_ambiguity: bool = False
+    workers: int | None = None
+    threads_per_worker: int = 1
+    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        self.cluster()  # checked when the configuration is made
         if self.looks_az < 1 or self.looks_rg < 1:
             raise ConfigError(f"--looks-az and --looks-rg must be at least 1, got {self.looks_az} and {self.looks_rg}")
         if self.pixel_spacing_m is not None and not (math.isfinite(self.pixel_spacing_m) and self.pixel_spacing_m > 0):
@@ -93,6 +105,20 @@ class Config:
     @property
     def outputs(self) -> tuple[Path | None, ...]:
         return (self.output, self.geotiff, self.geotiff_slant, self.quicklook)
+
+    def cluster(self):
+        """Where the blocks run: None (this process) or a :class:`sarcli.parallel.cluster.ClusterSpec`."""
+        if self.workers is None and self.scheduler is None:
+            return None
+        from sarcli.parallel.cluster import cluster_spec
+
+        return cluster_spec(self.scheduler, self.workers, self.threads_per_worker, use_env=False)
+
+    def stored(self) -> dict[str, Any]:
+        """The configuration recorded in the product (``parameters["config"]``): everything but where it ran."""
+        from sarcli.parallel.cluster import EXECUTION_FIELDS
+
+        return {k: v for k, v in to_mapping(self).items() if k not in EXECUTION_FIELDS}
 
 
 @dataclass
@@ -160,6 +186,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     """Focus ``config.raw`` into ``config.output`` (and the optional images); see the module docstring."""
     from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, options_for, run_blocks
+    from sarcli.io.atomic import all_or_nothing
 
     progress = progress or no_progress
     with using(provenance):
@@ -190,19 +217,20 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         if model is not None and config.fdc is None:
             _refuse_unresolved(model, config)
         t_doppler = time.perf_counter() - t0
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with all_or_nothing():  # the SLC, GeoTIFFs and quicklook appear together or not at all
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                t0 = time.perf_counter()
+                slc, sink = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo,
+                                           make_plan, run_blocks, progress)
+                t_focus = time.perf_counter() - t0
+            msgs = [str(w.message) for w in caught]
+            for m in msgs:
+                log.warning(m)
             t0 = time.perf_counter()
-            slc = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo, make_plan,
-                                 run_blocks, progress)
-            t_focus = time.perf_counter() - t0
-        msgs = [str(w.message) for w in caught]
-        for m in msgs:
-            log.warning(m)
-        t0 = time.perf_counter()
-        stats = _statistics(config.output)
-        products = _products(config, terrain, how)
-        t_products = time.perf_counter() - t0
+            stats = sink.statistics(slc.first_full_line, slc.last_full_line)
+            products = _products(config, slc, sink, terrain, how)
+            t_products = time.perf_counter() - t0
         d = slc.doppler
         import numpy as np
 
@@ -235,9 +263,13 @@ def _refuse_unfocusable(raw, path: Path) -> None:
 
 def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain, load_echo, make_plan, run_blocks,
                    progress: Progress):
-    """Plan, stream the blocks into the SLC product, write its metadata; returns the SLC metadata."""
+    """Plan, stream the blocks into the SLC product (and the sink), write its metadata; returns
+    (the SLC metadata, the sink)."""
+    from sarcli.focus.quicklook import quicklook_looks
+    from sarcli.focus.sink import BlockSink
     from sarcli.io.h5common import open_product
     from sarcli.io.slc import slc_writer
+    from sarcli.model import checks as ck
     from sarcli.model.slc import SLC
 
     ch = config.channel
@@ -250,27 +282,44 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
     plan = make_plan(focuser, plan_raw, shape, model, options, terrain)
     meta = SLC.placeholder(raw, plan.output_shape)
     inputs = tuple(p for p in (config.raw, config.doppler, config.dem) if p is not None)
+    looks = []
+    if config.geotiff or config.geotiff_slant:
+        looks.append((config.looks_az, config.looks_rg))
+    if config.quicklook:
+        looks.append(quicklook_looks(plan.output_shape, config.looks_az, config.looks_rg)[:2])
+    cluster = config.cluster()
+    if cluster is not None and not focuser.streams:
+        log.info("focuser %s does not stream its echo: focusing in this process", focuser.name)
+        cluster = None
     with slc_writer(config.output, meta, plan.output_shape, inputs=inputs) as out:
-        def sink(first, block):
+        def write(first, block):
             out[first:first + block.shape[0]] = block
+
+        sink = BlockSink(write, plan.output_shape, tuple(looks), str(Path(config.output).resolve().parent))
 
         def on_block(done, total):
             progress("focusing", done, total)
 
-        if focuser.streams and load_echo.raw is None:
+        if cluster is not None:
+            from sarcli.parallel.cluster import connect
+            from sarcli.parallel.focus import focus_blocks
+
+            with connect(cluster) as client:
+                slc = focus_blocks(client, focuser, plan, config.raw, ch, sink, on_block)
+        elif focuser.streams and load_echo.raw is None:
             with open_product(config.raw, "raw") as f:
                 ds = f["echo"] if ch == 0 else f["echo_channels"]
 
-                def read(a, b):
-                    return ds[a:b] if ch == 0 else ds[ch - 1, a:b]
+                def read(a, b):  # the samples of every block checked as they stream in (NaN, inf)
+                    return ck.array(str(config.raw), "echo", ds[a:b] if ch == 0 else ds[ch - 1, a:b], "c")
 
                 slc = run_blocks(focuser, plan, read, sink, on_block)
         else:
             echo = load_echo().channel(ch) if focuser.streams else plan_raw.echo
             slc = run_blocks(focuser, plan, lambda a, b: echo[a:b], sink, on_block)
-        slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": to_mapping(config)}
+        slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": config.stored()}
         meta.update_from(slc)
-    return slc
+    return slc, sink
 
 
 class _Echo:
@@ -289,47 +338,28 @@ class _Echo:
         return self.raw
 
 
-def _products(config: Config, terrain, how: str) -> dict[str, str]:
+def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
+    """GeoTIFFs and quicklook from the multilooked intensities the sink accumulated (``slc``: metadata)."""
     products = {"slc": str(config.output)}
-    if not (config.geotiff or config.geotiff_slant or config.quicklook):
-        return products
-    from sarcli.io.slc import read_slc
-
-    full = read_slc(config.output)
     tags = {"source_product": Path(config.output).name, "algorithm": config.algorithm, "doppler": how}
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 
-        write_slant_geotiff(config.geotiff_slant, full, config.looks_az, config.looks_rg, tags, terrain)
+        write_slant_geotiff(config.geotiff_slant, slc, config.looks_az, config.looks_rg, tags, terrain,
+                            inputs=(config.output,), intensity=sink.intensity(config.looks_az, config.looks_rg))
         products["geotiff_slant"] = str(config.geotiff_slant)
     if config.geotiff:
         from sarcli.focus.geocode import write_map_geotiff
 
-        used = write_map_geotiff(config.geotiff, full, config.looks_az, config.looks_rg, config.crs,
-                                 config.pixel_spacing_m, tags, terrain)
+        used = write_map_geotiff(config.geotiff, slc, config.looks_az, config.looks_rg, config.crs,
+                                 config.pixel_spacing_m, tags, terrain, inputs=(config.output,),
+                                 intensity=sink.intensity(config.looks_az, config.looks_rg))
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
     if config.quicklook:
-        from sarcli.focus.quicklook import write_slc_quicklook
+        from sarcli.focus.quicklook import quicklook_looks, write_slc_quicklook
 
-        write_slc_quicklook(config.quicklook, full, config.looks_az, config.looks_rg)
+        la, lr, _ = quicklook_looks((slc.azimuth_time.size, slc.slant_range.size), config.looks_az, config.looks_rg)
+        write_slc_quicklook(config.quicklook, slc, config.looks_az, config.looks_rg, intensity=sink.intensity(la, lr))
         products["quicklook"] = str(config.quicklook)
     return products
-
-
-def _statistics(path: Path) -> dict:
-    """Image statistics over the fully focused lines, read in row blocks (bounded memory)."""
-    from sarcli.errors import SarcliError
-    from sarcli.focus.quality import image_statistics
-    from sarcli.io.h5common import open_product
-
-    with open_product(path, "slc") as f:
-        ds = f["image"]
-        a = int(f.attrs.get("first_full_line", 0))
-        b = int(f.attrs.get("last_full_line", ds.shape[0] - 1)) + 1
-        if b <= a:
-            a, b = 0, ds.shape[0]
-        try:
-            return image_statistics(ds[c:min(b, c + 1024)] for c in range(a, b, 1024))
-        except SarcliError:
-            return {}

@@ -95,22 +95,40 @@ def slant_extent(img: GbsarImage) -> list[float]:
     return [img.azimuth_m[0], img.azimuth_m[-1], img.range_m[-1], img.range_m[0]]
 
 
+def gbsar_tags(img: GbsarImage, inputs: Iterable[str | os.PathLike], **extra: Any) -> dict[str, str]:
+    """GeoTIFF provenance tags of a picture of ``img`` (:func:`sarcli.io.images.provenance_tags`): the
+    wavelength at the centre frequency, the rail's look side, the scan time, the input files."""
+    from sarcli.io.images import provenance_tags
+
+    return provenance_tags(tuple(inputs), sensor="GB-SAR", wavelength_m=img.wavelength_m,
+                           look_side=img.site.look_side, acquisition=(img.epoch_utc, img.scan_time_s, img.scan_time_s),
+                           ALGORITHM=img.algorithm, RAIL_HEIGHT_M=img.rail_height_m, **extra)
+
+
 def map_outputs(raster: np.ndarray, img: GbsarImage, geotiff: Path | None, png: Path | None, title: str, label: str,
-                cmap: str, vmin: float, vmax: float, map_pixel_m: float | None) -> dict[str, Any]:
-    """UTM GeoTIFF (nearest resampling) and slant-plane PNG of a real-valued raster on ``img``'s grid."""
+                cmap: str, vmin: float, vmax: float, map_pixel_m: float | None, *, unit: str,
+                overview: str = "mean", inputs: Iterable[str | os.PathLike] = (),
+                brightness: np.ndarray | None = None, brightness_label: str = "") -> dict[str, Any]:
+    """UTM GeoTIFF (nearest resampling; a COG with ``unit``, ``label`` as the band description, the
+    ``overview`` reduction, provenance tags and a QGIS style ``cmap`` from ``vmin`` to ``vmax``) and a
+    slant-plane PNG of a real-valued raster on ``img``'s grid. With ``brightness`` (values in [0, 1],
+    e.g. the coherence) and a phase raster, the PNG shows hue = phase and brightness = that."""
     from sarcli.gbsar.geocode import resample_to_map
-    from sarcli.io.images import write_geotiff, write_quicklook
+    from sarcli.io.images import Band, Style, write_geotiff, write_phase_picture, write_quicklook
 
     out: dict[str, Any] = {}
     if geotiff is not None:
         pixel = map_pixel_m or float(img.range_m[1] - img.range_m[0])
         m, transform, crs, ginfo = resample_to_map(raster, img.range_m, img.azimuth_m, img.site, img.rail_height_m,
                                                    img.rail_centre_m, pixel, "utm")
-        write_geotiff(geotiff, m, crs, transform=transform, band_description=label)
+        write_geotiff(geotiff, Band(m, label, unit, overview), crs, transform=transform,
+                      tags=gbsar_tags(img, inputs), style=Style(1, vmin, vmax, cmap, label))
         out["geotiff"] = {"path": str(geotiff), "crs": crs, **ginfo}
     if png is not None:
-        write_quicklook(png, raster, title=title, cmap=cmap, is_db=True, vmin=vmin, vmax=vmax,
-                        extent=slant_extent(img), xlabel="azimuth x (m)", ylabel="range R0 (m)",
-                        colorbar_label=label)
+        kw = {"title": title, "extent": slant_extent(img), "xlabel": "azimuth x (m)", "ylabel": "range R0 (m)"}
+        if brightness is not None:
+            write_phase_picture(png, raster, brightness, brightness_label=brightness_label, **kw)
+        else:
+            write_quicklook(png, raster, cmap=cmap, is_db=True, vmin=vmin, vmax=vmax, colorbar_label=label, **kw)
         out["png"] = str(png)
     return out

@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
+
 from sarcli.errors import ConfigError
 from sarcli.gbsar.focus import FocusOptions, check_range_interval, image_from_scan
 from sarcli.gbsar.geocode import resample_to_map
@@ -30,7 +32,7 @@ from sarcli.io.images import amplitude_db, write_geotiff, write_quicklook
 from sarcli.io.scan import read_scan
 from sarcli.model.gbsar import GbsarImage
 from sarcli.workflows.base import Progress, Report, using
-from sarcli.workflows.gbsar_common import criterion_rad, guard, parameters, slant_extent
+from sarcli.workflows.gbsar_common import criterion_rad, gbsar_tags, guard, parameters, slant_extent
 
 
 @dataclass(frozen=True)
@@ -103,9 +105,13 @@ class GbsarFocusReport(Report):
 
 
 def image_outputs(img: GbsarImage, config: Config) -> dict[str, Any]:
-    """GeoTIFFs (UTM / ENU) and the quicklook of the first polarization's amplitude in dB."""
+    """GeoTIFFs (UTM / ENU) and the quicklook of the first polarization's amplitude in dB; pixels
+    without signal (not covered by the focusing, or exactly zero) are NaN (nodata), not a dB floor."""
+    from sarcli.io.images import Band, Style, db_stretch
+
     out: dict[str, Any] = {}
-    db = amplitude_db(img.image[0], floor_db=-200.0)
+    db = amplitude_db(img.image[0], floor_db=None)
+    db[img.algorithm_map == 0] = np.nan
     pixel = config.map_pixel_m or (float(img.range_m[1] - img.range_m[0]) if img.range_m.size > 1 else 1.0)
     for path, frame in ((config.geotiff, "utm"), (config.enu_geotiff, "enu")):
         if path is None:
@@ -113,8 +119,11 @@ def image_outputs(img: GbsarImage, config: Config) -> dict[str, Any]:
         raster, transform, crs, ginfo = resample_to_map(db, img.range_m, img.azimuth_m, img.site, img.rail_height_m,
                                                         img.rail_centre_m, pixel, frame, config.ground_height_m)
         out[f"{frame}_geotiff"] = {"path": str(path), "crs": crs, "shape": list(raster.shape), **ginfo}
-        write_geotiff(path, raster, crs, transform=transform, band_description=f"{img.polarizations[0]} amplitude (dB)",
-                      tags={"algorithm": img.algorithm, "epoch_utc": img.epoch_utc, "units": "dB"})
+        lo, hi = db_stretch(raster)
+        label = f"{img.polarizations[0]} amplitude 20 log10|z|, nearest slant pixel"
+        write_geotiff(path, Band(raster, label, "dB", "power_db"), crs, transform=transform,
+                      tags=gbsar_tags(img, (config.output,), MAP_FRAME=frame, GROUND_HEIGHT_M=config.ground_height_m),
+                      style=Style(1, lo, hi, "gray", label))
     if config.quicklook is not None and img.grid_z_m is not None:  # rows are y: draw them y up, 1 m = 1 m
         write_quicklook(config.quicklook, img.image[0][::-1],
                         title=f"{img.polarizations[0]} backprojection, z = {img.grid_z_m:g} m",

@@ -27,7 +27,8 @@ from sarcli.workflows.gbsar_common import guard, load_image, map_outputs, parame
 class Config:
     """The ``sarcli gbsar interfere`` options: reference A, secondary B, output; ``pol`` default: A's
     first; ``window``: coherence boxcar (pixels); ``ground_height_m``: the model's surface height;
-    GeoTIFF / PNG outputs of the residual phase and of the converted value."""
+    GeoTIFF / PNG outputs of the residual phase (PNG: hue = phase, brightness = coherence), of the
+    converted value (from the unwrapped residual) and of the coherence."""
 
     reference: Path
     secondary: Path
@@ -41,6 +42,8 @@ class Config:
     png: Path | None = None
     value_png: Path | None = None
     value_geotiff: Path | None = None
+    coherence_png: Path | None = None
+    coherence_geotiff: Path | None = None
     map_pixel_m: float | None = None
 
     def __post_init__(self) -> None:
@@ -82,7 +85,8 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
     """Interfere ``config.secondary`` against ``config.reference``; write the product and pictures."""
     c = config
     with using(provenance):
-        guard([c.reference, c.secondary], [c.output, c.geotiff, c.png, c.value_png, c.value_geotiff])
+        guard([c.reference, c.secondary], [c.output, c.geotiff, c.png, c.value_png, c.value_geotiff, c.coherence_png,
+                                           c.coherence_geotiff])
         a = load_image(c.reference)
         b = load_image(c.secondary, like=a)
         pol = (c.pol or a.polarizations[0]).upper()
@@ -95,15 +99,25 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
         write_interferogram(c.output, ifg, a.range_m, a.azimuth_m, attrs, parameters=parameters(c),
                             inputs=[c.reference, c.secondary])
         n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
-        outputs = map_outputs(ifg.residual, a, c.geotiff, c.png, f"{c.mode} residual phase ({pol})", "phase (rad)",
-                              "twilight", -np.pi, np.pi, c.map_pixel_m)
+        inputs = (c.reference, c.secondary)
+        outputs = map_outputs(ifg.residual, a, c.geotiff, c.png, f"{c.mode} residual phase ({pol})",
+                              "residual interferometric phase, wrapped", "twilight", -np.pi, np.pi, c.map_pixel_m,
+                              unit="rad", overview="phase", inputs=inputs, brightness=ifg.coherence,
+                              brightness_label=f"coherence ({c.window} x {c.window})")
         if c.value_png is not None or c.value_geotiff is not None:
             v = ifg.value[np.isfinite(ifg.value)]
             lo, hi = (np.percentile(v, [2, 98]) if v.size else (0.0, 1.0))
-            title = f"{c.mode} {ifg.value_name} (coherence >= {c.min_coherence:g})"
+            lo, hi = (float(lo), float(hi)) if hi > lo else (float(lo) - 1.0, float(lo) + 1.0)
+            title = f"{c.mode} {ifg.value_name}, unwrapped (coherence >= {c.min_coherence:g})"
             outputs["value_outputs"] = map_outputs(ifg.value, a, c.value_geotiff, c.value_png, title,
-                                                   f"{ifg.value_name} ({ifg.value_unit})", "viridis", float(lo),
-                                                   float(hi), c.map_pixel_m)
+                                                   f"{ifg.value_name} ({ifg.value_unit})",
+                                                   "RdBu_r" if c.mode == "dinsar" else "viridis", lo, hi,
+                                                   c.map_pixel_m, unit=ifg.value_unit, inputs=inputs)
+        if c.coherence_png is not None or c.coherence_geotiff is not None:
+            outputs["coherence_outputs"] = map_outputs(ifg.coherence, a, c.coherence_geotiff, c.coherence_png,
+                                                       f"coherence ({pol}, {c.window} x {c.window} boxcar)",
+                                                       "coherence", "gray", 0.0, 1.0, c.map_pixel_m, unit="1",
+                                                       inputs=inputs)
         if not n_valid:
             warnings.warn(f"no pixel has both images' support and coherence >= {c.min_coherence:g}: the value is "
                           "all NaN", stacklevel=2)

@@ -55,7 +55,8 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
         img = load_image(config.image)
         nd = normalized_difference(img.pol("HH"), img.pol("VV"), config.window)
         nd[~(support(img, "HH") & support(img, "VV"))] = np.nan  # blank outside the beam footprint
-        outputs = map_outputs(nd, img, config.geotiff, config.png, "(HH-VV)/(HH+VV)", "normalized difference",
-                              "RdBu_r", -1.0, 1.0, config.map_pixel_m)
+        outputs = map_outputs(nd, img, config.geotiff, config.png, "(HH-VV)/(HH+VV)",
+                              "normalized difference (HH-VV)/(HH+VV) of the intensities", "RdBu_r", -1.0, 1.0,
+                              config.map_pixel_m, unit="1", inputs=(config.image,))
         return GbsarPolarimetryReport(mean=float(np.nanmean(nd)), fraction_hh_dominant=float(np.nanmean(nd > 0)),
                                       outputs=outputs)

@@ -109,8 +109,10 @@ def _is_product(path: Path) -> bool:
     try:
         with h5py.File(path, "r") as f:
             return "product_type" in f.attrs
-    except OSError:
+    except OSError:  # not HDF5 at all
         return False
+    except Exception:  # an HDF5 file the library chokes on: open_product gives the one-line reason
+        return True
 
 
 def _is_rslc(path: Path) -> bool:
@@ -129,30 +131,36 @@ def describe_rslc(path: Path) -> dict[str, Any]:
             "mission_id": c.mission_id, "written_by_sarcli": c.written_by_sarcli}
 
 
+def _text(v: Any) -> Any:
+    """An attribute value for the summary: text decoded (invalid UTF-8 replaced), arrays as lists."""
+    if isinstance(v, bytes):
+        return v.decode(errors="replace")
+    if hasattr(v, "dtype") and v.dtype.kind == "S":
+        return v.astype(str).tolist()
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    return v
+
+
 def _attrs(obj) -> dict[str, Any]:
-    out = {}
-    for k in sorted(obj.attrs):
-        v = obj.attrs[k]
-        if isinstance(v, bytes):
-            v = v.decode(errors="replace")
-        elif hasattr(v, "dtype") and v.dtype.kind == "S":
-            v = v.astype(str)
-        out[k] = v
-    return out
+    """Every attribute of an HDF5 object, names and text decoded (a name that is not UTF-8 is shown
+    with replacement characters; the product readers have refused anything worse)."""
+    names = [k.decode(errors="replace") if isinstance(k, bytes) else str(k) for k in obj.attrs]
+    return {k: _text(v) for k, v in sorted(zip(names, obj.attrs.values(), strict=True))}
 
 
 def _datasets(f) -> list[dict[str, Any]]:
     import h5py
 
+    from sarcli.io.h5common import is_pure_dimension
+
     found: list[dict[str, Any]] = []
 
     def visit(name, obj):
-        if isinstance(obj, h5py.Dataset):
-            units = obj.attrs.get("units", None)
-            if isinstance(units, bytes):
-                units = units.decode(errors="replace")
+        if isinstance(obj, h5py.Dataset) and not is_pure_dimension(obj):
+            units = _text(obj.attrs.get("units", None))
             found.append({"path": "/" + name, "shape": list(obj.shape), "dtype": str(obj.dtype),
-                          "units": None if units is None else str(units)})
+                          "units": units if isinstance(units, str) else None})
     f.visititems(visit)
     return found
 
@@ -164,131 +172,104 @@ def _utc(epoch: str | None, seconds: float) -> str | None:
         return None
     try:
         return add_seconds(epoch, seconds)
-    except ValueError:
+    except (ValueError, OverflowError):
         return None
 
 
 def _span(t, epoch: str | None) -> dict[str, Any]:
-    """UTC start/stop and length of a vector of times (s after ``epoch``); {} when empty."""
-    if t.size == 0:
+    """UTC start/stop and length of a vector of times (s after ``epoch``); {} when empty or not finite."""
+    import numpy as np
+
+    t = np.asarray(t)
+    if t.size == 0 or t.dtype.kind not in "iuf" or not np.all(np.isfinite(t)):
         return {}
     return {"start_utc": _utc(epoch, float(t.min())), "stop_utc": _utc(epoch, float(t.max())),
             "span_s": float(t.max() - t.min())}
 
 
-def _time_span(f, name: str, epoch: str | None) -> dict[str, Any]:
-    return _span(f[name][()], epoch)
-
-
-def _raw_summary(f, summary: dict[str, Any]) -> None:
-    from sarcli.model.constants import C_LIGHT
-
-    radar = _attrs(f["radar"]) if "radar" in f else {}
-    epoch = summary.get("epoch_utc")
-    n_lines, n_samples = f["echo"].shape
-    span = _time_span(f, "azimuth_time", epoch) if "azimuth_time" in f else {}
-    fs = radar.get("range_sampling_rate_hz")
-    r0 = radar.get("first_range_m")
-    summary.update({
-        "shape": [n_lines, n_samples], "n_lines": n_lines, "n_samples": n_samples,
-        "prf_hz": radar.get("prf_hz"), "range_sampling_rate_hz": fs,
-        "wavelength_m": radar.get("wavelength_m"), "carrier_frequency_hz": radar.get("carrier_frequency_hz"),
-        "chirp_rate_hz_per_s": radar.get("chirp_rate_hz_per_s"), "pulse_length_s": radar.get("pulse_length_s"),
-        "first_range_m": r0,
-        "last_range_m": (r0 + (n_samples - 1) * C_LIGHT / (2 * fs)) if (r0 and fs) else None,
-        "quantization_bits": radar.get("quantization_bits"),
-        "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
-        "azimuth_span_s": span.get("span_s"),
-        "n_channels": summary.get("attributes", {}).get("n_channels", 1),
-        "has_replica": "replica" in f.get("radar", {}), "has_agc": "agc_db" in f.get("radar", {}),
-        "has_attitude": "attitude" in f, "has_truth": "truth" in f,
-        "radar": radar,
-    })
-    if "orbit" in f:
-        o = f["orbit"]
-        frame = o.attrs.get("frame", None)
-        ospan = _time_span(o, "time", epoch)
-        summary.update({"n_state_vectors": int(o["time"].shape[0]),
-                        "orbit_frame": frame.decode() if isinstance(frame, bytes) else frame,
-                        "orbit_start_utc": ospan.get("start_utc"), "orbit_stop_utc": ospan.get("stop_utc"),
-                        "orbit_span_s": ospan.get("span_s")})
-    else:
-        summary.update({"n_state_vectors": 0, "orbit_frame": None, "orbit_start_utc": None,
-                        "orbit_stop_utc": None, "orbit_span_s": None})
-
-
-def _slc_summary(f, summary: dict[str, Any]) -> None:
+def _slc_summary(path: Path) -> dict[str, Any]:
     """Shape, pixel spacings, algorithm, zero-Doppler time span and slant-range span of an SLC."""
-    a = summary["attributes"]
-    n_lines, n_samples = f["image"].shape
-    rng = f["slant_range"][()] if "slant_range" in f else None
-    span = _time_span(f, "azimuth_time", summary.get("epoch_utc")) if "azimuth_time" in f else {}
-    summary.update({
-        "main_dataset": "/image", "shape": [n_lines, n_samples], "n_lines": n_lines, "n_samples": n_samples,
-        "algorithm": a.get("algorithm"), "range_spacing_m": _num(a.get("range_spacing_m")),
-        "azimuth_spacing_m": _num(a.get("azimuth_spacing_m")), "prf_hz": _num(a.get("prf_hz")),
-        "first_full_line": _int(a.get("first_full_line")), "last_full_line": _int(a.get("last_full_line")),
-        "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
-        "azimuth_span_s": span.get("span_s"),
-        "first_range_m": float(rng[0]) if rng is not None and rng.size else None,
-        "last_range_m": float(rng[-1]) if rng is not None and rng.size else None,
-    })
+    from sarcli.io.slc import read_slc
+
+    s = read_slc(path, load_image=False)
+    span = _span(s.azimuth_time, s.epoch_utc)
+    n_lines, n_samples = s.azimuth_time.size, s.slant_range.size
+    return {"main_dataset": "/image", "shape": [n_lines, n_samples], "n_lines": n_lines, "n_samples": n_samples,
+            "algorithm": s.algorithm, "range_spacing_m": s.range_spacing_m, "azimuth_spacing_m": s.azimuth_spacing_m,
+            "prf_hz": s.prf_hz, "first_full_line": s.first_full_line, "last_full_line": s.last_full_line,
+            "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
+            "azimuth_span_s": span.get("span_s"), "first_range_m": float(s.slant_range[0]),
+            "last_range_m": float(s.slant_range[-1])}
 
 
-def _scan_summary(f, summary: dict[str, Any]) -> None:
+def _scan_summary(path: Path) -> dict[str, Any]:
     """Polarizations, stops (complete of planned), frequency sweep, rail extent and status of a scan."""
-    a = summary["attributes"]
-    freq = f["frequency"][()] if "frequency" in f else None
-    x = f["rail_position"][()] if "rail_position" in f else None
-    pols = a.get("polarizations")
-    summary.update({
-        "main_dataset": "/s21", "polarizations": pols.split(",") if isinstance(pols, str) and pols else [],
-        "status": a.get("status"), "n_stops_complete": _int(a.get("n_complete")),
-        "n_stops_planned": _int(a.get("n_planned")),
-        "n_frequencies": int(freq.size) if freq is not None else 0,
-        "frequency_start_hz": float(freq.min()) if freq is not None and freq.size else None,
-        "frequency_stop_hz": float(freq.max()) if freq is not None and freq.size else None,
-        "frequency_step_hz": float((freq[-1] - freq[0]) / (freq.size - 1)) if freq is not None and freq.size > 1
-        else None,
-        "rail_start_m": float(x.min()) if x is not None and x.size else None,
-        "rail_stop_m": float(x.max()) if x is not None and x.size else None,
-    })
+    from sarcli.io.scan import read_scan
+
+    s = read_scan(path)
+    f, x = s.frequency, s.rail_position
+    return {"main_dataset": "/s21", "polarizations": list(s.polarizations), "status": s.status,
+            "n_stops_complete": s.n_stops, "n_stops_planned": s.n_planned, "n_frequencies": int(f.size),
+            "frequency_start_hz": float(f[0]), "frequency_stop_hz": float(f[-1]),
+            "frequency_step_hz": float((f[-1] - f[0]) / (f.size - 1)) if f.size > 1 else None,
+            "rail_start_m": float(x.min()) if x.size else None, "rail_stop_m": float(x.max()) if x.size else None}
 
 
-def _num(v) -> float | None:
-    return None if v is None else float(v)
+def _validated(path: Path, product_type: str) -> dict[str, Any]:
+    """Read the product with its own reader, which validates it (a bad file is one ProductError line),
+    and return the type-specific part of the summary (from the validated model, not the file's layout)."""
+    if product_type == "raw":
+        from sarcli.io.raw import raw_shape, read_raw
 
+        out = raw_model_summary(read_raw(path, load_echo=False), raw_shape(path)[1])
+        for key in ("product_type", "attributes"):  # the file's own root attributes are listed already
+            out.pop(key)
+        return {**out, "main_dataset": "/echo"}
+    if product_type == "slc":
+        return _slc_summary(path)
+    if product_type == "gbsar_scan":
+        return _scan_summary(path)
+    if product_type == "gbsar_image":
+        from sarcli.io.gbsar_image import open_gbsar_image
 
-def _int(v) -> int | None:
-    return None if v is None else int(v)
+        with open_gbsar_image(path) as img:
+            return {"polarizations": list(img.polarizations), "algorithm": img.algorithm}
+    if product_type == "doppler":
+        from sarcli.io.doppler_product import read_doppler
+
+        m = read_doppler(path)
+        return {"fdc_hz": m.summary.fdc_hz if m.summary else None,
+                "ambiguity_resolved": m.ambiguity_resolved}
+    readers = {"interferogram": "sarcli.io.interferogram:read_interferogram", "ps": "sarcli.io.interferogram:read_ps",
+               "ati": "sarcli.io.ati_product:read_ati"}
+    if product_type in readers:
+        import importlib
+
+        module, _, name = readers[product_type].partition(":")
+        getattr(importlib.import_module(module), name)(path)
+    return {}
 
 
 def summarize(path: Path) -> dict[str, Any]:
-    """A JSON-ready summary of any sarcli product (keys in ``docs/ingest.md``)."""
+    """A JSON-ready summary of any sarcli product (keys in ``docs/ingest.md``), validated by its reader."""
     from sarcli.io.h5common import PROVENANCE_ATTRS, open_product, provenance
 
     with open_product(path) as f:
         prov = provenance(f)
         attrs = {k: v for k, v in _attrs(f).items() if k not in PROVENANCE_ATTRS}
         datasets = _datasets(f)
-        main = max(datasets, key=lambda d: (len(d["shape"]) > 0, math.prod(d["shape"])),
-                   default=None)
-        summary: dict[str, Any] = {
-            "file": str(path), "product_type": prov["product_type"], "schema_version": prov["schema_version"],
-            "shape": main["shape"] if main else [], "main_dataset": main["path"] if main else None,
-            "epoch_utc": attrs.get("epoch_utc"), "source": attrs.get("source"),
-            "provenance": prov, "attributes": attrs, "datasets": datasets,
-        }
-        summary["time_spans"] = {
-            d["path"]: _time_span(f, d["path"], summary["epoch_utc"]) for d in datasets
-            if d["units"] == "s" and len(d["shape"]) == 1 and "time" in d["path"].rsplit("/", 1)[-1]}
-        if prov["product_type"] == "raw" and "echo" in f:
-            summary["main_dataset"] = "/echo"
-            _raw_summary(f, summary)
-        elif prov["product_type"] == "slc" and "image" in f:
-            _slc_summary(f, summary)
-        elif prov["product_type"] == "gbsar_scan" and "s21" in f:
-            _scan_summary(f, summary)
+        main = max(datasets, key=lambda d: (len(d["shape"]) > 0, math.prod(d["shape"])), default=None)
+        epoch = attrs.get("epoch_utc") if isinstance(attrs.get("epoch_utc"), str) else None
+        spans = {d["path"]: _span(f[d["path"]][()], epoch) for d in datasets
+                 if (d["units"] == "s" or str(d["units"]).startswith("seconds since")) and len(d["shape"]) == 1
+                 and "time" in d["path"].rsplit("/", 1)[-1]}
+    summary: dict[str, Any] = {
+        "file": str(path), "product_type": prov["product_type"], "schema_version": prov["schema_version"],
+        "shape": main["shape"] if main else [], "main_dataset": main["path"] if main else None,
+        "epoch_utc": epoch, "source": attrs.get("source"), "provenance": prov, "attributes": attrs,
+        "datasets": datasets, "time_spans": spans,
+    }
+    summary.update(_validated(path, str(prov["product_type"])))
     return summary
 
 
@@ -296,12 +277,16 @@ def summarize(path: Path) -> dict[str, Any]:
 # raw inputs a sensor reader recognises
 
 
-def raw_model_summary(raw: Any) -> dict[str, Any]:
-    """The raw-product keys of :func:`summarize` computed from an in-memory :class:`RawProduct`."""
+def raw_model_summary(raw: Any, n_samples: int | None = None) -> dict[str, Any]:
+    """The raw-product keys of :func:`summarize` computed from a :class:`RawProduct` (``n_samples``: the
+    line length when the echo was not loaded)."""
     import dataclasses
 
+    from sarcli.model.constants import C_LIGHT
+
     r = raw.radar
-    n_lines, n_samples = raw.shape
+    n_lines = raw.shape[0]
+    n_samples = raw.shape[1] if n_samples is None else n_samples
     span = _span(raw.azimuth_time, raw.epoch_utc)
     o = raw.orbit
     ospan = _span(o.time, raw.epoch_utc) if o is not None else {}
@@ -311,7 +296,8 @@ def raw_model_summary(raw: Any) -> dict[str, Any]:
         "prf_hz": r.prf_hz, "range_sampling_rate_hz": r.range_sampling_rate_hz, "wavelength_m": r.wavelength_m,
         "carrier_frequency_hz": r.carrier_frequency_hz, "chirp_rate_hz_per_s": r.chirp_rate_hz_per_s,
         "pulse_length_s": r.pulse_length_s, "first_range_m": r.first_range_m,
-        "last_range_m": float(raw.slant_range()[-1]), "quantization_bits": r.quantization_bits,
+        "last_range_m": r.first_range_m + (n_samples - 1) * C_LIGHT / (2 * r.range_sampling_rate_hz),
+        "quantization_bits": r.quantization_bits,
         "azimuth_start_utc": span.get("start_utc"), "azimuth_stop_utc": span.get("stop_utc"),
         "azimuth_span_s": span.get("span_s"), "n_channels": raw.n_channels,
         "has_replica": raw.replica is not None, "has_agc": raw.agc_db is not None,

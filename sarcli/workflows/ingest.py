@@ -39,7 +39,7 @@ class Config:
     output: Path
     format: str | None = None
     options: dict[str, Any] = field(default_factory=dict)
-    compression: Literal["gzip", "lzf"] | None = None
+    compression: Literal["auto", "gzip", "lzf", "none"] | None = "auto"
 
     def __post_init__(self) -> None:
         if not self.sources:

@@ -12,18 +12,20 @@ from pathlib import Path
 from typing import Any
 
 from sarcli.errors import ConfigError, ProductError
-from sarcli.workflows.base import Progress, Provenance, Report, using
+from sarcli.workflows.base import Progress, Provenance, Report, refuse_overwriting_inputs, using
 
 
 @dataclass(frozen=True)
 class Config:
     """slc: the focused image (a sarcli SLC, or a NISAR RSLC: ``frequency``/``polarization`` choose its
-    layer); at: targets as (zero-Doppler time s, slant range m); empty: the truth's."""
+    layer); at: targets as (zero-Doppler time s, slant range m); empty: the truth's; plot: a PNG of the
+    targets' impulse responses (range and azimuth cuts, 2-D contours)."""
 
     slc: Path
     at: tuple[tuple[float, float], ...] = ()
     frequency: str | None = None
     polarization: str | None = None
+    plot: Path | None = None
 
     def __post_init__(self) -> None:
         for t, r in self.at:
@@ -53,6 +55,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     from sarcli.focus.quality import measure_targets, truth_targets
     from sarcli.io.nisar.rslc import read_image
 
+    refuse_overwriting_inputs([config.slc], [config.plot] if config.plot is not None else [])
     with using(provenance):
         slc = read_image(config.slc, config.frequency, config.polarization)
         if slc.azimuth_time.size < 2 or slc.slant_range.size < 2:
@@ -61,4 +64,12 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         if not positions:
             raise ConfigError(f"{config.slc}: no truth targets in the product; give positions with "
                               "--at TIME_S,RANGE_M")
-        return QualityReport(measure_targets(slc, positions, truth_known=not config.at))
+        targets = measure_targets(slc, positions, truth_known=not config.at)
+        if config.plot is not None:
+            from sarcli.calibration.plots import plot_point_targets
+            from sarcli.focus.quality import azimuth_ground_spacing
+
+            plot_point_targets(config.plot, slc.image, targets, float(slc.slant_range[1] - slc.slant_range[0]),
+                               azimuth_ground_spacing(slc), title=f"{Path(config.slc).name}: point-target "
+                               "impulse responses (ground along-track, slant range)")
+        return QualityReport(targets)

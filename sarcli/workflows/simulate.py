@@ -31,7 +31,7 @@ class Config:
     scene: Path
     output: Path
     format: Literal["hdf5", "ceos", "s1-l0"] = "hdf5"
-    compression: Literal["gzip", "lzf"] | None = None
+    compression: Literal["auto", "gzip", "lzf", "none"] | None = "auto"
     seed: int | None = None
 
     def __post_init__(self) -> None:

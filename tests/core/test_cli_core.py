@@ -10,7 +10,7 @@ from sarcli import __version__
 
 def test_version(cli):
     r = cli("--version")
-    assert r.exit_code == 0 and r.stdout.strip() == __version__
+    assert r.exit_code == 0 and r.stdout.splitlines()[0] == f"sarcli {__version__}"  # then the libraries
 
 
 def test_help_lists_commands(cli):

@@ -2,7 +2,7 @@
 
     cli -> workflows -> processing -> io, model -> orbit
 
-with the base modules (errors, config, registry) usable from every layer. A module may import its own
+with the base modules (errors, config, registry, threads) usable from every layer. A module may import its own
 layer and the layers below; ``model`` may not import ``io``; ``orbit`` imports nothing of sarcli. Every
 ``import`` statement counts, also those inside functions (a lazy import is still a dependency).
 """
@@ -14,10 +14,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 
-BASE = {"sarcli", "sarcli.errors", "sarcli.config", "sarcli.registry"}
-PROCESSING = {"doppler", "focus", "ati", "gbsar", "sim", "optical", "design", "acquire", "monitor", "calibration",
-              "parallel"}
-RANK = {"orbit": 0, "model": 1, "io": 2, "processing": 3, "workflows": 4, "cli": 5}
+BASE = {"sarcli", "sarcli.errors", "sarcli.config", "sarcli.registry", "sarcli.threads", "sarcli.versions"}
+PROCESSING = {"doppler", "focus", "ati", "gbsar", "sim", "optical", "design", "acquire", "monitor", "calibration"}
+#: sarcli.parallel sits beside the workflows (it runs them as Dask tasks, they call it for block-parallel focus)
+RANK = {"orbit": 0, "model": 1, "io": 2, "processing": 3, "workflows": 4, "parallel": 4, "cli": 5}
 
 
 def _layer(module: str) -> str | None:

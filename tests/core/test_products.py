@@ -55,7 +55,7 @@ def test_raw_round_trip(tmp_path):
     assert q.truth["scene_toml"] == "[scene]\n"
     with h5py.File(tmp_path / "r.h5") as f:
         assert f["echo"].chunks is not None
-        assert f["azimuth_time"].attrs["units"] == "s"
+        assert f["azimuth_time"].attrs["units"] == "seconds since 2002-06-16T15:41:00.000000"  # CF, UTC
         prov = provenance(f)
     assert prov["product_type"] == "raw" and prov["parameters"] == {"k": 1}
 

@@ -103,7 +103,8 @@ def test_products_record_the_callers_provenance(tmp_path):
     with h5py.File(out) as f:
         assert f.attrs["command_line"] == "dask batch task 17"
         params = json.loads(f.attrs["parameters"])
-    assert params["workflow"] == "simulate" and params["config"] == {"scene": str(SCENE), "format": "hdf5"}
+    assert params["workflow"] == "simulate" and params["config"] == {"scene": str(SCENE), "format": "hdf5",
+                                                                       "compression": "auto"}
     calls = []
     report = sim.run(sim.Config(scene=SCENE, output=tmp_path / "b.h5", seed=5),
                      progress=lambda label, done, total: calls.append((label, done, total)))

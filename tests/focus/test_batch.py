@@ -59,7 +59,7 @@ def test_make_batch_three_scenes(cli, tmp_path):
     r = _make(inp, out)
     assert r.returncode == 0, r.stderr
     changed = {p.name for p in out.iterdir() if p.stat().st_mtime_ns != stamps.get(p.name)}
-    assert changed == {"b.doppler.h5", "b.slc.h5", "b.tif", "b.png"}
+    assert changed == {"b.doppler.h5", "b.slc.h5", "b.tif", "b.qml", "b.png"}  # b.qml: the GeoTIFF's QGIS style
 
 
 def test_make_batch_stops_on_a_bad_input_with_its_name(tmp_path):

@@ -5,7 +5,8 @@ sources for reads of ``truth`` (``x.truth[...]``, ``(x.truth or {}).get``, ``tru
 Allowed, each named: the quality and validation modules, whose job is to compare with the truth
 (``sarcli/focus/quality.py`` and ``sarcli/workflows/quality.py``: ``sarcli quality``;
 ``sarcli/optical/compare.py``: ``sarcli optical compare`` against the truth targets;
-``sarcli/ati/montecarlo.py``: the Monte-Carlo accuracy of the ATI estimates against the truth).
+``sarcli/ati/montecarlo.py``: the Monte-Carlo accuracy of the ATI estimates against the truth;
+``sarcli/doppler/plot.py``: the ``--plot`` picture draws a simulated product's truth beside the estimate).
 The simulators write the truth (``sarcli/sim``, ``sarcli/gbsar/simulate.py``) and do not read it
 back; products copy it through (``truth=raw.truth``) without looking inside.
 """
@@ -19,7 +20,8 @@ import pytest
 
 SARCLI = Path(__file__).resolve().parents[2] / "sarcli"
 PACKAGES = ("doppler", "focus", "ati", "gbsar", "optical", "workflows")
-ALLOWED = {"focus/quality.py", "workflows/quality.py", "optical/compare.py", "ati/montecarlo.py", "ati/evaluation.py"}
+ALLOWED = {"focus/quality.py", "workflows/quality.py", "optical/compare.py", "ati/montecarlo.py", "ati/evaluation.py",
+           "doppler/plot.py"}
 READS = re.compile(r"\.truth\b[^\n]*?(\[|\.get\()|\btruth\s*\[|\btruth\.get\(|reference_height_m")
 
 

@@ -444,37 +444,25 @@ def fuzz_settings(examples: int) -> Any:
 
 # ----------------------------------------------------------------------------------------------------
 # what is fuzzed: (damaged product, command) pairs. ``{IN}`` is the damaged product, ``{raw}`` etc. a
-# pristine one, ``{OUT}`` an output. PENDING pairs fail today in code this suite does not own (listed in
-# test_fuzz_pending.py); they run with ``-m fuzz_pending``.
+# pristine one, ``{OUT}`` an output.
 
 FDC_FR = ("--fdc", "-6590", "--fr", "-1787")
 COMMANDS: dict[str, list[tuple[str, ...]]] = {
-    "raw": [("doppler", "{IN}", "-o", "{OUT}"), ("focus", "{IN}", "-o", "{OUT}"), ("orbit", "info", "{IN}")],
-    "scan": [("gbsar", "focus", "{IN}", "-o", "{OUT}"), ("gbsar", "interfere", "{IN}", "{scan2}", "-o", "{OUT}")],
+    "raw": [("doppler", "{IN}", "-o", "{OUT}"), ("focus", "{IN}", "-o", "{OUT}"), ("orbit", "info", "{IN}"),
+            ("info", "{IN}"), ("info", "{IN}", "--json"), ("focus", "{IN}", *FDC_FR, "-o", "{OUT}"),
+            ("focus", "{IN}", "--doppler", "{doppler}", "-o", "{OUT}")],
+    "doppler": [("focus", "{raw}", "--doppler", "{IN}", "-o", "{OUT}"), ("info", "{IN}")],
+    "slc": [("quality", "{IN}"), ("quality", "{IN}", "--json"), ("info", "{IN}", "--json")],
+    "scan": [("gbsar", "focus", "{IN}", "-o", "{OUT}"), ("gbsar", "interfere", "{IN}", "{scan2}", "-o", "{OUT}"),
+             ("info", "{IN}")],
     "image": [("gbsar", "interfere", "{IN}", "{image2}", "-o", "{OUT}"),
-              ("gbsar", "polarimetry", "{IN}", "--png", "{OUT_PNG}")],
+              ("gbsar", "polarimetry", "{IN}", "--png", "{OUT_PNG}"), ("info", "{IN}")],
     "ceos": [("ingest", "{IN}", "-o", "{OUT}")],
 }
 #: Costly pairs (about 1 s a case): the exploration run only.
 EXPLORE_ONLY: dict[str, list[tuple[str, ...]]] = {
     "raw": [("focus", "{IN}", *FDC_FR, "-o", "{OUT}", "--geotiff", "{OUT_TIF}", "--quicklook", "{OUT_PNG}")],
 }
-PENDING: dict[str, list[tuple[str, ...]]] = {
-    "raw": [("info", "{IN}"), ("info", "{IN}", "--json"), ("focus", "{IN}", *FDC_FR, "-o", "{OUT}"),
-            ("focus", "{IN}", "--doppler", "{doppler}", "-o", "{OUT}")],
-    "doppler": [("focus", "{raw}", "--doppler", "{IN}", "-o", "{OUT}"), ("info", "{IN}")],
-    "slc": [("quality", "{IN}"), ("quality", "{IN}", "--json"), ("info", "{IN}", "--json")],
-    "scan": [("info", "{IN}")],
-    "image": [("info", "{IN}")],
-}
-
-
-def outside_truth(path: str) -> bool:
-    """Objects outside /truth: doppler and focus still read /truth/reference_height_m (issue 13 §4,
-    owned by their workflows), so damage to /truth is fuzzed in test_fuzz_pending.py until they stop."""
-    return not (path == "/truth" or path.startswith("/truth/"))
-
-
 def corruptions(pristine: Any, product: str, where: Callable[[str], bool] = lambda path: True,
                 file_level: bool = True) -> st.SearchStrategy[Corruption]:
     """Every kind of damage to a pristine product (HDF5: to the objects ``where`` selects, and to its

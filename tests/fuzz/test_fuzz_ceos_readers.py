@@ -1,6 +1,6 @@
 """Fuzz ``sarcli ingest`` on damaged CEOS folders, and the SLC and interferogram readers on damaged
-products (the commands that read those, ``quality`` and ``info``, have defects of their own, listed
-in test_fuzz_pending.py). The promises: tests/fuzz/harness.py."""
+products (the commands that read SLCs are fuzzed in test_fuzz_cases.py). The promises:
+tests/fuzz/harness.py."""
 
 from __future__ import annotations
 

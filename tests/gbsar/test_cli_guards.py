@@ -136,7 +136,9 @@ def test_focus_refuses_a_single_stop(cli, tmp_path):
 
 
 def _reverse(f):
-    for name in ("rail_position", "rail_height", "stop_time", "stop_flags"):
+    """The stops measured in the other order: positions, heights, flags and sweeps reversed; the stop times
+    still increase (the clock runs forward whatever way the rail moves)."""
+    for name in ("rail_position", "rail_height", "stop_flags"):
         f[name][...] = f[name][()][::-1]
     f["s21"][...] = f["s21"][()][:, ::-1]
 

@@ -16,7 +16,7 @@ RAW_KEYS = {  # released keys: tests pin them (issue 2 "Machine-readable output"
     "epoch_utc", "provenance", "attributes", "datasets", "main_dataset", "n_lines", "n_samples",
     "azimuth_stop_utc", "azimuth_span_s", "carrier_frequency_hz", "chirp_rate_hz_per_s", "pulse_length_s",
     "last_range_m", "quantization_bits", "n_channels", "has_replica", "has_agc", "has_attitude", "has_truth",
-    "radar", "orbit_start_utc", "orbit_stop_utc", "orbit_span_s", "time_spans",
+    "radar", "orbit_start_utc", "orbit_stop_utc", "orbit_span_s", "time_spans", "look_side",
 }
 GENERIC_KEYS = {"file", "product_type", "schema_version", "shape", "main_dataset", "epoch_utc", "source",
                 "provenance", "attributes", "datasets", "time_spans"}
@@ -44,21 +44,22 @@ def test_raw_info_keys_and_values(cli, make_raw, tmp_path):
 
 
 def test_generic_product_summary(cli, tmp_path):
-    # A product type this command does not know (e.g. added later by another module).
-    with atomic_h5(tmp_path / "s.h5", "slc", "3", parameters={"algorithm": "rd"}) as f:
+    # A product type this command does not know (e.g. added later by another module): described from its
+    # layout (a known type is read, and validated, by its own reader first).
+    with atomic_h5(tmp_path / "s.h5", "widget", "3", parameters={"algorithm": "rd"}) as f:
         f.attrs["epoch_utc"] = "2002-06-16T15:41:00.000000Z"
         dataset(f, "image", np.zeros((12, 34), np.complex64), units="1")
         dataset(f, "range_m", np.arange(34.0), units="m")
         dataset(f, "azimuth_time", 10.0 + np.arange(12) * 0.5, units="s")
     s = json.loads(cli("info", tmp_path / "s.h5", "--json").stdout)
     assert GENERIC_KEYS <= set(s)
-    assert s["product_type"] == "slc" and s["schema_version"] == "3" and s["shape"] == [12, 34]
+    assert s["product_type"] == "widget" and s["schema_version"] == "3" and s["shape"] == [12, 34]
     assert s["main_dataset"] == "/image" and s["provenance"]["parameters"] == {"algorithm": "rd"}
     assert {d["path"]: d["units"] for d in s["datasets"]} == {"/image": "1", "/range_m": "m", "/azimuth_time": "s"}
     assert s["time_spans"] == {"/azimuth_time": {"start_utc": "2002-06-16T15:41:10.000000Z",
                                                  "stop_utc": "2002-06-16T15:41:15.500000Z", "span_s": 5.5}}
     human = cli("info", tmp_path / "s.h5")
-    assert "slc product" in human.stdout and "/range_m: float64 [34] [m]" in human.stdout
+    assert "widget product" in human.stdout and "/range_m: float64 [34] [m]" in human.stdout
 
 
 def test_info_refuses_non_products(cli, tmp_path):

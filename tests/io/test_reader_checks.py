@@ -255,8 +255,8 @@ def _stop(name, k, value):
 SCAN_DAMAGE = [
     ("rail NaN", _stop("rail_position", 2, np.nan), "rail_position contains NaN"),
     ("rail constant", _data("rail_position", lambda x: np.zeros_like(x)), "rail_position must increase"),
-    ("rail reversed", _data("rail_position", lambda x: x[::-1].copy()), "rail_position must increase"),
     ("rail not monotonic", _stop("rail_position", 3, 0.01), "rail_position must increase"),
+    ("rail back and forth", _data("rail_position", lambda x: np.r_[x[::-1][:-2], x[:2]]), "must move one way"),
     ("rail height NaN", _stop("rail_height", 1, np.nan), "rail_height contains NaN"),
     ("rail height implausible", _stop("rail_height", 1, 1e6), "rail_height has implausible values"),
     ("n_complete -1", _set("", "n_complete", -1), "n_complete = -1 is implausible"),

@@ -42,7 +42,7 @@ def test_export_writes_an_rslc_with_the_command_line(cli, slc_file, tmp_path):
 
 
 @pytest.mark.parametrize("args, code, message", [
-    (["--format", "sicd"], 2, "unknown export format 'sicd'"),
+    (["--format", "geojpeg"], 2, "unknown export format 'geojpeg'"),
     (["--option", "colour=red"], 2, "unknown option(s) colour"),
     (["--option", "nokey"], 2, "expected KEY=VALUE"),
     (["--frequency", "A"], 2, "apply to NISAR RSLC files only"),

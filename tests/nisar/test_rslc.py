@@ -139,7 +139,7 @@ def test_refusals(sim_slc, tmp_path):
     with pytest.raises(ConfigError, match="polarization"):
         write_format(sim_slc, tmp_path / "x.h5", "nisar-rslc", {"polarization": "XY"})
     with pytest.raises(ConfigError, match="unknown export format"):
-        write_format(sim_slc, tmp_path / "x.h5", "sicd")
+        write_format(sim_slc, tmp_path / "x.h5", "geojpeg")
     assert not (tmp_path / "x.h5").exists()
 
 

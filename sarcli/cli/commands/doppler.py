@@ -29,24 +29,26 @@ def doppler(
     height: float = typer.Option(0.0, "--height", help="Terrain height under the scene, metres above the WGS-84 "
                                  "ellipsoid (for the geometric model; stored in the product)."),
     dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),
-    dem_geoid: str = typer.Option(None, "--dem-geoid", help="The DEM's heights are above this geoid: egm96 | "
+    dem_geoid: str = typer.Option(None, "--dem-geoid", metavar="[egm96|egm2008]",
+                                  help="The DEM's heights are above this geoid: egm96 | "
                                   "egm2008 (default: above the ellipsoid)."),
     estimator: str = typer.Option("cde", "--estimator",
                                   help="cde | sde | rc-cde (CDE after range compression) | lb (look balance on "
                                        "the focused scene: robust to scene contrast, needs > 2 look apertures) | "
                                        "a registered plug-in."),
-    gain_steps: str = typer.Option("auto", "--gain-steps",
+    gain_steps: str = typer.Option("auto", "--gain-steps", metavar="[auto|on|off]",
                                    help="Receiver-gain steps recovered from the echo and undone: auto (quantized "
                                         "products without AGC records) | on | off."),
     lb_band: float = typer.Option(0.6, "--lb-band", help="Look-balance processed band, fraction of the PRF."),
     az_block: int = typer.Option(2048, "--az-block", help="Azimuth lines per block (seed: 2048)."),
     rg_block: int = typer.Option(128, "--rg-block", help="Range samples per block (seed: 128)."),
-    ambiguity: str = typer.Option("auto", "--ambiguity",
+    ambiguity: str = typer.Option("auto", "--ambiguity", metavar="[auto|orbit|data|none]",
                                   help="auto | orbit | data (MLCC+MLBF) | none; auto = orbit if present."),
     ambiguity_value: int = typer.Option(None, "--ambiguity-value", help="Force the scene ambiguity number."),
-    fr_method: str = typer.Option("auto", "--fr-method",
+    fr_method: str = typer.Option("auto", "--fr-method", metavar="[auto|orbit|seed|mapdrift]",
                                   help="auto | orbit (exact d2R/deta2) | seed (look angle re-solved) | mapdrift."),
-    fdc_model: str = typer.Option("vector", "--fdc-model", help="Geometric model: vector | closed (seed eq. 6)."),
+    fdc_model: str = typer.Option("vector", "--fdc-model", metavar="[vector|closed]",
+                                  help="Geometric model: vector | closed (seed eq. 6)."),
     fit_degree: str = typer.Option("2,1", "--fit-degree", help="Block fit degrees RANGE,AZIMUTH (no orbit)."),
     n_nodes: int = typer.Option(None, "--hermite-nodes", help="Hermite interpolation nodes (default: orbit's)."),
     small_angle: bool = typer.Option(False, "--small-angle", help="Small-angle attitude rotation (seed)."),

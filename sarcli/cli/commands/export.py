@@ -33,13 +33,15 @@ def _options(values: list[str]) -> dict[str, object]:
 def export(
     source: Path = typer.Argument(..., help="Focused image: a sarcli SLC product or a NISAR RSLC file."),
     output: Path = typer.Option(..., "-o", "--output", help="File to write."),
-    fmt: str = typer.Option("nisar-rslc", "--format", help="Output format (built in: nisar-rslc)."),
+    fmt: str = typer.Option("nisar-rslc", "--format", metavar="[nisar-rslc|sicd|envi|PLUG-IN]",
+                            help="Output format (built in: nisar-rslc, sicd, envi)."),
     polarization: str = typer.Option(None, "--polarization",
                                      help="Layer name: for a sarcli SLC the polarization it is (default HH); for "
                                           "an RSLC input the layer to read (default HH, else the first)."),
     frequency: str = typer.Option(None, "--frequency", help="RSLC input only: the sub-band to read (A, B)."),
     option: list[str] = typer.Option(None, "--option", help="Format option KEY=VALUE, repeatable "
-                                     "(nisar-rslc: frequency, mission_id, instrument, compression)."),
+                                     "(nisar-rslc: frequency, mission_id, instrument, compression; sicd: "
+                                     "collector, classification; envi: gcps)."),
     as_json: bool = typer.Option(False, "--json", help="Print the report as JSON on stdout."),
 ) -> None:
     """Write a focused image in an interchange format; sarcli's own SLC stays the working format.
@@ -48,6 +50,11 @@ def export(
     slant range, ECEF orbit, attitude quaternions, Doppler centroid LUT, geolocation grid,
     identification and sarcli's provenance. ISCE3's NISAR readers open it.
 
+    sicd: NGA SICD 1.4.0 in NITF (RMA/INCA, zero-Doppler grid) through sarkit, checked by its
+    consistency checker; every SICD tool opens it (needs the 'sicd' extra: pip install 'sarcli[sicd]').
+
+    envi: the complex image as ENVI .img + .hdr with corner ground control points (GDAL, ENVI, QGIS).
+
     Examples:
 
       sarcli export slc.h5 --format nisar-rslc -o rslc.h5
@@ -55,6 +62,10 @@ def export(
       sarcli export slc.h5 -o rslc.h5 --polarization HV --option compression=gzip --json
 
       sarcli export isce3_rslc.h5 --polarization VV -o vv_only.h5
+
+      sarcli export slc.h5 --format sicd -o slc.nitf
+
+      sarcli export slc.h5 --format envi -o slc.img
     """
     from sarcli.config import from_mapping
     from sarcli.workflows.export import Config, run

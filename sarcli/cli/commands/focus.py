@@ -35,7 +35,8 @@ def focus(
     channel: int = typer.Option(0, "--channel", help="Receive channel to focus (0 = /echo)."),
     height: float = typer.Option(0.0, "--height", help="Terrain height above the WGS-84 ellipsoid, m (default 0)."),
     dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),
-    dem_geoid: str = typer.Option(None, "--dem-geoid", help="The DEM's heights are above this geoid: egm96 | "
+    dem_geoid: str = typer.Option(None, "--dem-geoid", metavar="[egm96|egm2008]",
+                                  help="The DEM's heights are above this geoid: egm96 | "
                                   "egm2008 (default: above the ellipsoid)."),
     range_window: str = typer.Option(None, "--range-window", help="rect | hamming[:a] | kaiser[:beta] "
                                      "(default kaiser:2.5)."),
@@ -65,6 +66,10 @@ def focus(
     looks_az: int = typer.Option(1, "--looks-az", help="Azimuth looks for the GeoTIFFs/quicklook."),
     looks_rg: int = typer.Option(1, "--looks-rg", help="Range looks for the GeoTIFFs/quicklook."),
     quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the amplitude (dB)."),
+    workers: int = typer.Option(None, "--workers", help="Focus the blocks in parallel on a local Dask cluster of "
+                                "this many processes (the same image)."),
+    scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
+                                  "scheduler (tcp://host:8786; the raw file must be visible to its workers)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON report on stdout."),
 ) -> None:
     """Focus a stripmap raw product into a single-look complex image.
@@ -88,6 +93,8 @@ def focus(
       sarcli focus raw.h5 -o slc.h5 --dem srtm.tif --dem-geoid egm96 --geotiff amp.tif
 
       sarcli focus raw.h5 -o bp.h5 --algorithm backprojection --set lines=[900,1000] --range-window rect
+
+      sarcli focus big_raw.h5 -o slc.h5 --fdc -6690 --fr -1990 --workers 2
     """
     given = {"range_window": range_window, "azimuth_window": azimuth_window, "azimuth_bandwidth": azimuth_bandwidth,
              "range_band_fraction": range_band_fraction, "rcmc": rcmc, "rcmc_oversample": rcmc_oversample,
@@ -106,7 +113,7 @@ def focus(
                     options=options, height_m=height, dem=dem, dem_geoid=_geoid(dem_geoid), geotiff=geotiff,
                     geotiff_slant=geotiff_slant, quicklook=quicklook, crs=crs, pixel_spacing_m=spacing,
                     looks_az=looks_az, looks_rg=looks_rg, channel=channel,
-                    accept_unresolved_ambiguity=accept_unresolved)
+                    accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler)
     with progress_bar(1, label="focusing") as bar:
         def progress(label: str, done: int, total: int) -> None:
             bar.length = total

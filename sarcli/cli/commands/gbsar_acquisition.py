@@ -32,7 +32,8 @@ def scan_cmd(
     power: float = typer.Option(None, "--power", help="Source power, dBm."),
     data_format: str = typer.Option(None, "--data-format", help="FORM4 (ASCII), FORM2 or FORM3 (binary)."),
     pol: str = typer.Option(None, "--pol", help="Polarizations, TX then RX letter, e.g. VV or VV,VH,HV,HH."),
-    switch: str = typer.Option(None, "--switch", help="Polarization switch: none, grbl or 11713a."),
+    switch: str = typer.Option(None, "--switch", metavar="[none|grbl|11713a]",
+                               help="Polarization switch: none, grbl or 11713a."),
     rail_start: float = typer.Option(None, "--rail-start", help="First stop, m (rail frame)."),
     step: float = typer.Option(None, "--step", help="Rail step, m."),
     count: int = typer.Option(None, "--count", help="Number of stops."),
@@ -77,7 +78,8 @@ def emulate_cmd(
     faults: str = typer.Option("", "--faults", help="Faults NAME@N[:ARG],... (vna-timeout garble truncate "
                                "slow-sweep vna-unplug grbl-error alarm stall lost-ok status-garble rail-unplug)."),
     time_scale: float = typer.Option(1.0, "--time-scale", help="Sweep/move duration factor (0 = instant)."),
-    switch: str = typer.Option("none", "--switch", help="Emulated polarization switch: none, grbl, 11713a."),
+    switch: str = typer.Option("none", "--switch", metavar="[none|grbl|11713a]",
+                               help="Emulated polarization switch: none, grbl, 11713a."),
     pol: str = typer.Option("VV", "--pol", help="The fixed polarization when --switch none."),
     machine_zero: float = typer.Option(None, "--machine-zero", help="Rail-frame position (m) of GRBL X0 "
                                        "(default: the scene's first stop, else 0)."),

@@ -61,7 +61,8 @@ def import_cmd(
                                  "[default: position, pos, ..., or x,y,z]."),
     reference_range: str = typer.Option(None, "--reference-range", help="Range (m) each sweep's phase is referenced "
                                         "to, per sweep or one value [default: r0, R0, reference_range if present]."),
-    layout: str = typer.Option("auto", "--layout", help="auto | frequency-position | position-frequency (needed when "
+    layout: str = typer.Option("auto", "--layout", metavar="[auto|frequency-position|position-frequency]",
+                               help="auto | frequency-position | position-frequency (needed when "
                                "the matrix is square)."),
     pol: str = typer.Option(None, "--pol", help="Polarization VV|VH|HV|HH [default: from the file names, else VV]."),
     height: float = typer.Option(0.0, "--height", help="Antenna height (m) of 1-D rail positions."),
@@ -120,7 +121,7 @@ def plan_cmd(
 def focus_cmd(
     scan: Path = typer.Argument(..., help="Scan product (.h5)."),
     output: Path = typer.Option(..., "-o", "--output", help="Output image product (.h5)."),
-    algorithm: str = typer.Option("auto", "--algorithm", help="auto | df | rd | bp."),
+    algorithm: str = typer.Option("auto", "--algorithm", metavar="[auto|df|rd|bp]", help="auto | df | rd | bp."),
     pol: list[str] = typer.Option(None, "--pol", help="Polarization(s) to focus [default: all]."),
     max_range: float = typer.Option(None, "--max-range", help="Largest image range R0 (m) [default: R_max]."),
     min_range: float = typer.Option(0.0, "--min-range", help="Smallest image range R0 (m)."),
@@ -129,9 +130,10 @@ def focus_cmd(
     width: float = typer.Option(None, "--width", help="Azimuth width of the image (m) [default: beam "
                                 "footprint at the top range plus the rail, at most DF's width]."),
     criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg) for auto."),
-    near: str = typer.Option("bp", "--near", help="auto's near-range algorithm: bp | rd."),
+    near: str = typer.Option("bp", "--near", metavar="[bp|rd]", help="auto's near-range algorithm: bp | rd."),
     n_xfft: int = typer.Option(None, "--n-xfft", help="Azimuth FFT size for DF/RD [default: the paper's rule]."),
-    rd_reference: str = typer.Option("sinc", "--rd-reference", help="RD reference weighting: sinc (real "
+    rd_reference: str = typer.Option("sinc", "--rd-reference", metavar="[sinc|rect]",
+                                     help="RD reference weighting: sinc (real "
                                      "antenna) | rect (the paper's ideal beam)."),
     range_window: str = typer.Option("hamming", "--range-window", help=f"Taper over the frequencies: {_WINDOW_HELP}."),
     azimuth_window: str = typer.Option("hamming", "--azimuth-window",
@@ -184,14 +186,17 @@ def interfere_cmd(
     reference: Path = typer.Argument(..., help="Reference image (or scan) A."),
     secondary: Path = typer.Argument(..., help="Secondary image (or scan) B; the interferogram is B * conj(A)."),
     output: Path = typer.Option(..., "-o", "--output", help="Output interferogram product (.h5)."),
-    mode: str = typer.Option("dinsar", "--mode", help="dinsar | crosstrack | deltaf | combined."),
+    mode: str = typer.Option("dinsar", "--mode", metavar="[dinsar|crosstrack|deltaf|combined]",
+                             help="dinsar | crosstrack | deltaf | combined."),
     pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of A]."),
     window: int = typer.Option(5, "--window", help="Coherence boxcar window (pixels)."),
     ground_height: float = typer.Option(0.0, "--ground-height", help="Reference surface height z (m) of the model."),
     geotiff: Path = typer.Option(None, "--geotiff", help="UTM GeoTIFF of the residual phase (rad)."),
-    png: Path = typer.Option(None, "--png", help="PNG of the residual phase (cyclic colour map)."),
-    value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m)."),
+    png: Path = typer.Option(None, "--png", help="PNG of the residual phase: hue = phase, brightness = coherence."),
+    value_png: Path = typer.Option(None, "--value-png", help="PNG of the converted value (mm or m), unwrapped."),
     value_geotiff: Path = typer.Option(None, "--value-geotiff", help="UTM GeoTIFF of the converted value."),
+    coherence_png: Path = typer.Option(None, "--coherence-png", help="PNG of the coherence (0..1)."),
+    coherence_geotiff: Path = typer.Option(None, "--coherence-geotiff", help="UTM GeoTIFF of the coherence."),
     min_coherence: float = typer.Option(0.5, "--min-coherence", help="The converted value (product, --value-png, "
                                         "--value-geotiff) is NaN where the coherence is below this (0 keeps all)."),
     map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
@@ -199,7 +204,8 @@ def interfere_cmd(
 ) -> None:
     """Interferogram of two GB-SAR images: phase, coherence, model phase removed, converted value.
 
-    dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m).
+    dinsar -> LOS displacement (mm); crosstrack / combined -> height (m); deltaf -> range offset (m),
+    from the residual phase unwrapped spatially (SNAPHU, coherence-weighted; docs/gbsar.md).
     Scans given instead of images are focused with --algorithm auto first. Pixels outside the beam
     footprint (no image support) are NaN (blank in PNGs, nodata in GeoTIFFs); the converted value is
     also NaN where the coherence is below --min-coherence.
@@ -209,12 +215,15 @@ def interfere_cmd(
       sarcli gbsar interfere t2.h5 t3.h5 --mode crosstrack -o xt.h5 --png xt.png --value-png height.png
 
       sarcli gbsar interfere t1.h5 t2.h5 --mode dinsar -o dinsar.h5 --value-geotiff los.tif --json
+
+      sarcli gbsar interfere t1.h5 t2.h5 -o dinsar.h5 --png phase.png --coherence-png coherence.png
     """
     from sarcli.workflows import gbsar_interfere as wf
 
     cfg = wf.Config(reference=reference, secondary=secondary, output=output, mode=mode, pol=pol, window=window,
                     ground_height_m=ground_height, min_coherence=min_coherence, geotiff=geotiff, png=png,
-                    value_png=value_png, value_geotiff=value_geotiff, map_pixel_m=map_pixel)
+                    value_png=value_png, value_geotiff=value_geotiff, coherence_png=coherence_png,
+                    coherence_geotiff=coherence_geotiff, map_pixel_m=map_pixel)
     run_workflow(wf, cfg, json_out)
 
 
@@ -228,20 +237,27 @@ def coherence_cmd(
     pol: str = typer.Option(None, "--pol", help="Polarization [default: the first of the first image]."),
     csv: Path = typer.Option(None, "--csv", help="CSV of the PS time series."),
     plot: Path = typer.Option(None, "--plot", help="PNG: coherence map and PS displacement series."),
+    workers: int = typer.Option(None, "--workers", help="Run the pixel-block tasks on a local Dask cluster of "
+                                "this many processes."),
+    scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Run them on this Dask scheduler "
+                                  "(tcp://host:8786)."),
     json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
     """Temporal coherence |sum z|/sum|z|, persistent-scatterer selection and PS phase/displacement series.
 
-    The images are read block by block (bounded memory, however many there are).
+    The images are read block by block (bounded memory, however many there are), as a task graph
+    over pixel blocks (here, or on a Dask cluster with --workers / --scheduler: the same result).
 
     Examples:
 
       sarcli gbsar coherence p1.h5 p2.h5 p3.h5 p4.h5 --threshold 0.99 -o ps.h5 --csv ps.csv --plot ps.png
+
+      sarcli gbsar coherence scans/*.h5 -o ps.h5 --workers 2
     """
     from sarcli.workflows import gbsar_coherence as wf
 
     cfg = wf.Config(images=tuple(images), output=output, threshold=threshold, dynamic_range_db=dynamic_range_db,
-                    pol=pol, csv=csv, plot=plot)
+                    pol=pol, csv=csv, plot=plot, workers=workers, scheduler=scheduler)
     run_workflow(wf, cfg, json_out)
 
 

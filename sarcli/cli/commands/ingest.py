@@ -41,7 +41,9 @@ def ingest(
                                 help="CEOS: refuse gaps longer than this many lines (zero/repeat; default 200)."),
     f3_pulses: int = typer.Option(None, "--f3-pulses",
                                   help="CEOS: pulses in flight for beam F3 (9 per ASF MapReady, default; 8 per ISCE)."),
-    compression: str = typer.Option(None, "--compression", help="HDF5 compression of the echo (gzip, lzf)."),
+    compression: str = typer.Option(None, "--compression", metavar="[auto|gzip|lzf|none]",
+                                   help="HDF5 compression of the echo: auto = shuffle + gzip where it pays "
+                                        "(quantized echoes)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
     """Ingest raw data: the sensor reader is found by sniffing the input (or named with --format).

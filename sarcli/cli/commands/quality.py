@@ -32,6 +32,8 @@ def quality(
                                            "UAVSAR CSV): offsets from the orbit's prediction and the IRF of each."),
     plots: Path = typer.Option(None, "--plots", help="With --corner-reflectors: a folder for one IRF PNG per "
                                "reflector."),
+    plot: Path = typer.Option(None, "--plot", help="PNG of the point targets' impulse responses: range and "
+                              "azimuth cuts and 2-D contours, one row per target."),
     frequency: str = typer.Option(None, "--frequency", help="NISAR RSLC layer: frequency A or B (default: first)."),
     polarization: str = typer.Option(None, "--polarization", help="NISAR RSLC layer: HH, HV, ... (default HH)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object per target (a list) on stdout."),
@@ -52,11 +54,15 @@ def quality(
 
       sarcli quality slc.h5 --json
 
+      sarcli quality slc.h5 --plot irf.png
+
       sarcli quality slc.h5 --at -3.758,993644.5 --at -3.9485,992646.0
 
       sarcli quality rslc.h5 --corner-reflectors CR.csv --plots cr_plots --json
     """
     if corner_reflectors is not None:
+        if plot is not None:
+            raise ConfigError("--plot draws point targets; with --corner-reflectors use --plots FOLDER")
         if at:
             raise ConfigError("--at and --corner-reflectors are two ways to name the targets: give one")
         from sarcli.workflows import corner_reflectors as crw
@@ -73,7 +79,8 @@ def quality(
         raise ConfigError("--plots goes with --corner-reflectors")
     from sarcli.workflows.quality import Config, run
 
-    rep = run(Config(slc=slc_path, at=_parse_at(at or []), frequency=frequency, polarization=polarization))
+    rep = run(Config(slc=slc_path, at=_parse_at(at or []), frequency=frequency, polarization=polarization,
+                     plot=plot))
     if as_json:
         emit_json(rep.to_dict()["targets"])
         return

@@ -12,9 +12,12 @@ from sarcli.cli.common import emit_json, print_status, run_workflow
 def simulate(
     scene: Path = typer.Argument(..., help="Scene file (TOML): radar, antenna, platform, targets, effects."),
     output: Path = typer.Option(..., "-o", "--output", help="Raw product (HDF5) or, with --format ceos, a folder."),
-    fmt: str = typer.Option("hdf5", "--format", help="hdf5 (raw product), ceos (Radarsat-1 leader + data) or s1-l0 "
+    fmt: str = typer.Option("hdf5", "--format", metavar="[hdf5|ceos|s1-l0]",
+                            help="hdf5 (raw product), ceos (Radarsat-1 leader + data) or s1-l0 "
                       "(Sentinel-1 Level-0 packets; needs a Sentinel-1 sampling rate, e.g. samples/s1_stripmap.toml)."),
-    compression: str = typer.Option(None, "--compression", help="HDF5 compression of the echo (gzip, lzf)."),
+    compression: str = typer.Option(None, "--compression", metavar="[auto|gzip|lzf|none]",
+                                   help="HDF5 compression of the echo: auto = shuffle + gzip where it pays "
+                                        "(quantized echoes)."),
     seed: int = typer.Option(None, "--seed", min=0, help="Override the scene's seed (Monte-Carlo runs)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:

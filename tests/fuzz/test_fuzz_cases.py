@@ -1,12 +1,6 @@
-"""Fuzz cases that fail today in code outside the product readers (issue 13): each asserts the same
-promises as the CI fuzz tests (tests/fuzz/harness.py) and is deselected by default (marker
-``fuzz_pending``); run them with
-
-    .venv/bin/python -m pytest -q tests/fuzz/test_fuzz_pending.py -m fuzz_pending
-
-Each explicit case names the file that owns the defect. Once those are fixed, move the pairs of
-``harness.PENDING`` into ``harness.COMMANDS`` and drop the marker.
-"""
+"""Explicit fuzz cases, each a defect the fuzzer once found outside the product readers (issue 13), kept
+as regressions with the file that had it; and the fuzz over the Doppler and SLC products (read by
+focus, quality and info). Same promises as every fuzz test (tests/fuzz/harness.py)."""
 
 from __future__ import annotations
 
@@ -20,21 +14,17 @@ from tests.fuzz.harness import (
     BAD_UTF8,
     COMMANDS,
     FDC_FR,
-    PENDING,
     AttrEdit,
     DataEdit,
     GroupEdit,
     check_output,
     fuzz,
     fuzz_settings,
-    outside_truth,
     run_case,
 )
 
-pytestmark = pytest.mark.fuzz_pending
-
 KNOWN = [
-    # (id, damaged product, corruption, command, what happens today, owner)
+    # (id, damaged product, corruption, command, what happened before the fix, where it was)
     ("info-no-radar", "raw", GroupEdit("/radar", "delete"), ("info", "{IN}"),
      "TypeError: unsupported format string passed to NoneType.__format__", "sarcli/cli/commands/info.py _human"),
     ("info-no-azimuth-time", "raw", DataEdit("/azimuth_time", "delete"), ("info", "{IN}"),
@@ -90,28 +80,18 @@ KNOWN = [
 
 @pytest.mark.parametrize("product, corruption, command, today, owner", [k[1:] for k in KNOWN],
                          ids=[k[0] for k in KNOWN])
-def test_known_defect(pristine, product, corruption, command, today, owner):
+def test_known_case(pristine, product, corruption, command, today, owner):
     run_case(pristine.paths, product, command, corruption, check_output)
 
 
-@pytest.mark.parametrize("product", sorted(PENDING))
-def test_fuzz_pending(pristine, product):
-    @fuzz_settings(100)
+@pytest.mark.parametrize("product", ["doppler", "slc"])
+def test_fuzz_products(pristine, product):
+    @fuzz_settings(60)
     @given(data=st.data())
-    def pending(data):
-        fuzz(pristine, product, PENDING[product], data)
+    def damaged(data):
+        fuzz(pristine, product, COMMANDS[product], data)
 
-    pending()
-
-
-def test_fuzz_raw_truth(pristine):
-    """Damage to /truth through doppler and focus, which still read /truth/reference_height_m (§4)."""
-    @fuzz_settings(100)
-    @given(data=st.data())
-    def truth(data):
-        fuzz(pristine, "raw", COMMANDS["raw"], data, where=lambda p: not outside_truth(p), file_level=False)
-
-    truth()
+    damaged()
 
 
 WRITERS = [  # (input, command whose {SELF} output names the input file itself, that file within a folder)

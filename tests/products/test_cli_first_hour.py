@@ -1,0 +1,66 @@
+"""The first hour at the command line: -h, shell completion, --version with the libraries' own version
+strings, choices in --help, and the documented exit codes (docs/cli.md; 3 = instrument is exercised by
+tests/acquire)."""
+
+from __future__ import annotations
+
+import pytest
+
+
+def test_h_is_help(cli):
+    for args in ((), ("gbsar", "focus"), ("export",)):
+        a, b = cli(*args, "-h"), cli(*args, "--help")
+        assert a.exit_code == b.exit_code == 0 and a.stdout == b.stdout and "Usage:" in a.stdout
+
+
+def test_completion_scripts(cli):
+    """The console script prints a bash completion script for itself (the program name comes from argv)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    exe = Path(sys.executable).parent / "sarcli"
+    if not exe.exists():
+        pytest.skip("the sarcli console script is not installed beside this interpreter")
+    r = subprocess.run([str(exe), "--show-completion", "bash"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and "_SARCLI_COMPLETE=complete_bash" in r.stdout and "complete " in r.stdout
+    assert "--install-completion" in cli("--help").stdout
+
+
+def test_version_names_the_libraries_as_they_report_themselves(cli):
+    import numba
+    import numpy
+    import pyproj
+    import rasterio
+
+    out = cli("--version").stdout.splitlines()
+    assert out[0].startswith("sarcli ")
+    got = dict(line.split() for line in out[1:])
+    assert got["numpy"] == numpy.__version__ and got["numba"] == numba.__version__
+    assert got["GDAL"] == rasterio.__gdal_version__ and got["PROJ"] == pyproj.proj_version_str
+
+
+@pytest.mark.parametrize("args, shown", [
+    (("gbsar", "focus"), "[auto|df|rd|bp]"), (("gbsar", "interfere"), "[dinsar|crosstrack|deltaf|combined]"),
+    (("simulate",), "[hdf5|ceos|s1-l0]"), (("doppler",), "[auto|orbit|data|none]"),
+    (("export",), "[nisar-rslc|sicd|envi|PLUG-IN]"), (("ingest",), "[auto|gzip|lzf|none]")])
+def test_choices_in_help(cli, args, shown):
+    assert shown in " ".join(cli(*args, "-h").stdout.split())
+
+
+def test_exit_codes(cli, tmp_path, monkeypatch):
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"not hdf5")
+    r = cli("info", junk)  # bad data
+    assert r.exit_code == 1 and r.stderr.startswith("sarcli: error:") and len(r.stderr.splitlines()) == 1
+    r = cli("gbsar", "interfere", junk, junk, "-o", tmp_path / "x.h5", "--window", "0")  # usage
+    assert r.exit_code == 2 and r.stderr.startswith("sarcli: error:")
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    import sarcli.workflows.export as export
+
+    monkeypatch.setattr(export, "run", interrupted)
+    r = cli("export", junk, "-o", tmp_path / "x.nitf", "--format", "sicd")
+    assert r.exit_code == 130 and r.stderr.strip() == "sarcli: error: interrupted"

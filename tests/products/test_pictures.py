@@ -1,0 +1,68 @@
+"""Pictures people read: the Doppler plot (no degenerate azimuth panel, the truth on its ranges), the
+quality impulse-response PNG, hue/brightness phase pictures, the quicklook's time-axis note against the
+simulator's beam-centre and zero-Doppler times."""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+import pytest
+
+from sarcli.io.images import phase_rgb
+
+
+def _png_size(path) -> tuple[int, int]:
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", head[16:24])  # width, height of the IHDR chunk
+
+
+def test_phase_rgb_hue_and_brightness():
+    ph = np.array([[0.0, np.pi, -np.pi / 2, 0.0, np.nan]])
+    br = np.array([[1.0, 1.0, 1.0, 0.0, 1.0]])
+    rgba = phase_rgb(ph, br)
+    # hsv with hue (phi + pi) / 2 pi: 0 -> hue 1/2 (cyan), pi -> hue 0 (red), -pi/2 -> hue 1/4 (yellow-green)
+    np.testing.assert_allclose(rgba[0, 0, :3], [0.0, 1.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(rgba[0, 1, :3], [1.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(rgba[0, 2, :3], [0.5, 1.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(rgba[0, 3, :3], [0.0, 0.0, 0.0], atol=1e-12)  # no coherence: black
+    assert rgba[0, 4, 3] == 0.0 and np.all(rgba[0, :4, 3] == 1.0)  # no data: transparent
+
+
+@pytest.mark.slow
+def test_doppler_plot_three_range_panels_for_one_azimuth_block(cli, small, tmp_path):
+    from sarcli.doppler.plot import truth_curves
+    from sarcli.io.doppler_product import read_doppler
+    from sarcli.io.raw import read_raw
+
+    png, d = tmp_path / "d.png", tmp_path / "d.h5"
+    r = cli("doppler", small.raw, "-o", d, "--plot", png)
+    assert r.exit_code == 0, r.stderr
+    assert read_doppler(d).summary.n_az_blocks == 1
+    assert _png_size(png) == (1000, 960)  # 3 panels of 3.2 in at 100 dpi: no azimuth-time panel
+    raw = read_raw(small.raw, load_echo=False)
+    t = truth_curves(raw)
+    c, rad = 299792458.0, raw.radar
+    np.testing.assert_allclose(t["range_m"][[0, -1]], c / 2 * (rad.window_start_s + np.array([0, 599])
+                                                             / rad.range_sampling_rate_hz))
+    assert t["fdc_hz"].shape == (600,)
+
+
+@pytest.mark.slow
+def test_quality_plot_and_time_axis_note(cli, small, tmp_path):
+    from sarcli.focus.quicklook import time_axis_label
+    from sarcli.io.slc import read_slc
+
+    png = tmp_path / "irf.png"
+    r = cli("quality", small.slc, "--plot", png)
+    assert r.exit_code == 0, r.stderr
+    assert _png_size(png) == (1400, 800)  # one row of 4 in per target, two targets
+    slc = read_slc(small.slc, load_image=False)
+    tg = slc.truth["targets"]
+    lead = float(np.mean(tg["beam_center_time_s"] - tg["zero_doppler_time_s"]))  # the simulator's own times
+    label = time_axis_label(slc)
+    shown = float(label.split("this ")[1].split(" s")[0])
+    assert label.startswith("zero-Doppler time (s)") and shown == pytest.approx(lead, abs=0.05)
+    assert lead > 3.0  # RADARSAT-1's squint: the -3.7 s of the issue
