@@ -6,30 +6,13 @@ missing files, and a warning says so in the summary (a skipped real-data test mu
 
 from __future__ import annotations
 
-import os
 import warnings
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-DATA = Path(os.environ.get("SARCLI_SHARED", REPO.parent / "shared")) / "data"
-BLOCKS_DIR = DATA / "rs1_vancouver_blocks"
-AGC = BLOCKS_DIR / "AGC_attenuation_values.mat"
-#: name -> (data, params, first line, first cell) as the bench reads them (the first block's start is
-#: settled by its AGC alignment and its bit-identical overlaps: line 7769, cell 1050)
-BLOCKS = {
-    "coal_ferry_terminals": (BLOCKS_DIR / "coal_ferry_terminals.mat",
-                             BLOCKS_DIR / "coal_ferry_terminals_run_params.mat", None, None),
-    "vancouver_airport": (BLOCKS_DIR / "vancouver_airport.mat", BLOCKS_DIR / "vancouver_airport_run_params.mat",
-                          None, None),
-    "ubc_one_ship": (BLOCKS_DIR / "ubc_one_ship.mat", BLOCKS_DIR / "ubc_one_ship_run_params.mat", None, None),
-    "stanley_park_city": (BLOCKS_DIR / "stanley_park_city.mat", BLOCKS_DIR / "stanley_park_city_run_params.mat",
-                          None, None),
-    "block1": (DATA / "rs1_vancouver_block1.mat", DATA / "rs1_vancouver_run_params.mat", 7769, 1050),
-    "squamish_garibaldi": (BLOCKS_DIR / "squamish_garibaldi.mat", BLOCKS_DIR / "squamish_garibaldi_run_params.mat",
-                           None, None),
-}
+# the pass's block table (paths, and the first block's start settled by its AGC alignment and its
+# bit-identical overlaps: line 7769, cell 1050) is the benchmark's: one table for both
+from bench.bench_rs1_blocks import AGC, BLOCKS
 
 
 @pytest.fixture(scope="session")
