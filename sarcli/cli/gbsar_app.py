@@ -15,7 +15,7 @@ from typing import Any
 
 import typer
 
-from sarcli.cli.common import emit_json, info, make_typer, progress_bar
+from sarcli.cli.common import emit_json, info, make_typer, progress_sink
 
 gbsar_app = make_typer(
     help="Ground-based SAR: simulate, import, plan, focus, interfere, coherence; acquire with a VNA and a rail; "
@@ -42,22 +42,6 @@ def warning_lines() -> Iterator[None]:
         finally:
             for w in caught:
                 info(f"sarcli: warning: {w.message}")
-
-
-@contextlib.contextmanager
-def progress_sink() -> Iterator[Callable[[str, int, int], None]]:
-    """A workflow ``progress(label, done, total)`` drawing one bar per label (only on a terminal)."""
-    with contextlib.ExitStack() as stack:
-        bars: dict[str, list[Any]] = {}
-
-        def sink(label: str, done: int, total: int) -> None:
-            if label not in bars:
-                bars[label] = [stack.enter_context(progress_bar(total, label=label)), 0]
-            bar, last = bars[label]
-            bar.update(done - last)
-            bars[label][1] = done
-
-        yield sink
 
 
 def run_workflow(workflow: ModuleType, config: Any, json_out: bool, text: Callable[[str], None] = info,
