@@ -11,14 +11,14 @@ call (scipy.fft scratch is not counted), next to Table 1's ``N_Rfft x N_xfft x 8
 Goals: outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
 everywhere at no more than twice DF's time plus the near-range part.
 
-RD core vs a naive numpy RD (issue 19): ``focus_rd`` (complex64 numba kernels) against
+RD core vs a naive numpy RD: ``focus_rd`` (complex64 numba kernels) against
 ``focus_rd_reference`` (the plain-numpy implementation it replaced: complex128 reference per block,
 ``nanmedian`` per column) on both polarizations of samples/gbsar_outdoor.toml, 600 m image, in
 interleaved rounds (best of each), with the normwise difference of the images.
 
-PS coherence (issue 15): ``sarcli gbsar coherence`` on N image products of the outdoor grid, read by
-blocks of rows from their HDF5 files, against the former whole-stack computation (every image read,
-``np.stack``): wall time and tracemalloc peak of each.
+PS coherence (docs/parallel.md, "GB-SAR time series"): ``sarcli gbsar coherence`` on N image products of the
+outdoor grid, read by blocks of rows from their HDF5 files, against the former whole-stack computation (every image
+read, ``np.stack``): wall time and tracemalloc peak of each.
 """
 
 from __future__ import annotations

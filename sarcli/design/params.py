@@ -45,7 +45,7 @@ PLATFORMS = ("airborne", "spaceborne", "gbsar")
 
 @dataclass(frozen=True)
 class Processor:
-    """The AOD/CCD optical processor of seed 004 (all optional): CCD rows and line rate, AOD aperture (m)
+    """The AOD/CCD optical processor of [KimAODCCD] (all optional): CCD rows and line rate, AOD aperture (m)
     and acoustic velocity (m/s)."""
 
     ccd_rows: int | None = None
