@@ -1,4 +1,4 @@
-"""GB-SAR acquisition overhead per stop with a zero-latency emulator (issue 7: < 50 ms at 1601
+"""GB-SAR acquisition overhead per stop with a zero-latency emulator (goal: < 50 ms at 1601
 points x 4 polarizations).
 
 The emulator runs in its own process (``sarcli gbsar emulate --time-scale 0``, a calibrated thru, so
@@ -8,7 +8,7 @@ as ``sarcli gbsar scan`` does. With zero sweep and move time, everything a stop 
 - ``stop wall``: whole stop (move + G4 finish check + status, 4 x [switch, OPC?;SING poll, OUTPDATA
   transfer, parse], HDF5 append + flush);
 - ``controller overhead``: the part outside ``move_to`` and ``sweep`` (switching, data transfer and
-  parsing, writing and flushing) -- the issue's "parsing, writing, flushing" figure, wall time, so it
+  parsing, writing and flushing) -- the goal's "parsing, writing, flushing" figure, wall time, so it
   includes the emulator's formatting and the pty transfer (80 kB per sweep in FORM4);
 - ``client CPU``: CPU time of the scanning process per stop (all protocol handling, parsing, HDF5);
 - microbenchmarks of the parts: FORM4 / binary parsing vs. a plain ``np.frombuffer`` reference, and

@@ -1,7 +1,7 @@
 """ATI benchmark: accuracy vs time of the estimation routes, unwrapping methods, full Monte-Carlo.
 
 1. Routes on the paper scenario (samples/ati_paper.toml, 20 dB, simulated and RD-focused once):
-   seed (quadratic LS, paper's chain), exact (closed-form geometry), nonlinear (full fit), with the
+   seed (quadratic LS, the chain of [Ryu2017, Fig. 2]), exact (closed-form geometry), nonlinear (full fit), with the
    conventional compensation's azimuth position error; seconds per mover (best of 3, estimation
    only: focusing and detection are shared and reported separately).
 2. Same routes on slow-time signals synthesized from the exact bistatic history (plain numpy,

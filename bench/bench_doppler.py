@@ -1,4 +1,4 @@
-"""Doppler benchmarks (issue 4): what accuracy costs in time, CDE throughput, and the real-data figures.
+"""Doppler benchmarks (docs/doppler.md): what accuracy costs in time, CDE throughput, and the real-data figures.
 
 Sections (all measured in one run, same machine):
   A. CDE/SDE throughput on a full-size 23000 x 6354 complex64 array vs the memory-bandwidth bound: a
@@ -6,7 +6,7 @@ Sections (all measured in one run, same machine):
      threads; the faster); a one-thread numpy sum for comparison; numba first call separately.
   B. Block size vs estimator standard deviation vs time (synthetic azimuth process of known centroid).
   C. CDE vs SDE vs range-compressed CDE on a simulated Radarsat-1-like clutter scene (truth in /truth).
-  D. Seed closed form (eq. 6) vs full vector model: difference and cost, over attitudes.
+  D. Closed form of [Koh2003, eq. 6] vs full vector model: difference and cost, over attitudes.
   E. Hermite order vs fdc / fr error (against the simulator's truth) and interpolation cost.
   F. Real data: the Vancouver block (baseband per range block with quality, 512 vs 1536 lines,
      data-only ambiguity + confidence, map-drift rate).
@@ -220,7 +220,7 @@ def section_models(out: dict, raw) -> str:
         data.append({"pitch_deg": pd, "yaw_deg": yd, "max_abs_diff_hz": d, "us_per_point_vector": tv / 200 * 1e6,
                      "us_per_point_closed": tc / 200 * 1e6})
     out["models"] = data
-    return ("## D. Seed closed form (eq. 6) vs full vector model (200 points over the scene; extra pitch/yaw on "
+    return ("## D. Closed form of [Koh2003, eq. 6] vs full vector model (200 points over the scene; extra pitch/yaw on "
             "top of the simulated attitude)\n\n"
             + markdown_table(["extra pitch / yaw (deg)", "mean fdc (Hz)", "max |closed - vector| (Hz)",
                               "vector (us/point)", "closed (us/point)"], rows)

@@ -1,4 +1,4 @@
-"""GB-SAR focusing: DF vs RD vs BP vs auto on seed 000's two configurations (Table 1 sizes).
+"""GB-SAR focusing: DF vs RD vs BP vs auto on the two configurations of [LeeGBSAR-II-2007] (Table 1 sizes).
 
 Each configuration is simulated with point targets at several ranges and azimuths (no clutter,
 no noise), focused onto the default Cartesian grid of ``sarcli gbsar focus``, and every algorithm is
@@ -8,17 +8,17 @@ Time: best of 3 after a warm-up (numba compiled or loaded from its cache in the 
 first-call time is reported separately). Memory: tracemalloc peak of numpy allocations during one
 call (scipy.fft scratch is not counted), next to Table 1's ``N_Rfft x N_xfft x 8`` bytes.
 
-Goals (issue 6): outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
+Goals: outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
 everywhere at no more than twice DF's time plus the near-range part.
 
-RD core vs a naive numpy RD (issue 19): ``focus_rd`` (complex64 numba kernels) against
+RD core vs a naive numpy RD: ``focus_rd`` (complex64 numba kernels) against
 ``focus_rd_reference`` (the plain-numpy implementation it replaced: complex128 reference per block,
 ``nanmedian`` per column) on both polarizations of samples/gbsar_outdoor.toml, 600 m image, in
 interleaved rounds (best of each), with the normwise difference of the images.
 
-PS coherence (issue 15): ``sarcli gbsar coherence`` on N image products of the outdoor grid, read by
-blocks of rows from their HDF5 files, against the former whole-stack computation (every image read,
-``np.stack``): wall time and tracemalloc peak of each.
+PS coherence (docs/parallel.md, "GB-SAR time series"): ``sarcli gbsar coherence`` on N image products of the
+outdoor grid, read by blocks of rows from their HDF5 files, against the former whole-stack computation (every image
+read, ``np.stack``): wall time and tracemalloc peak of each.
 """
 
 from __future__ import annotations

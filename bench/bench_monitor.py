@@ -1,4 +1,4 @@
-"""Monitoring campaign store (issue 21): the incremental update's cost against the number of scans
+"""Monitoring campaign store (docs/monitoring.md): the incremental update's cost against the number of scans
 already stored (up to 1,000), and the offline rebuild (``gbsar series``) against a serial loop.
 
 1. Incremental update: a campaign on the landslide sample's grid (162 x 111 pixels, one image focused

@@ -1,4 +1,4 @@
-"""Parallel and streaming benchmarks (issue 15; issue 19 item 2). Ratios of the same run only.
+"""Parallel and streaming benchmarks (docs/parallel.md). Ratios of the same run only.
 
 1. Many scenes: 8 simulated Radarsat-1 scenes (``samples/rs1_point.toml``, 2048 x 2400) through
    ``sarcli batch`` (doppler -> focus -> GeoTIFF + quicklook): ``--workers 0`` (one process, one scene
@@ -8,7 +8,7 @@
 2. Big scene 23000 x 6354 (random echo, Radarsat-1 radar and the sample's orbit, so that the GeoTIFF
    can be made): ``sarcli focus --fdc/--fr --geotiff --quicklook`` as a process vs the yardstick
    process (import h5py + scipy, read /echo whole, two ``scipy.fft.fft2`` with all cores), alternated,
-   best of each; its peak RSS vs the raw file size. Goals (issue 19): <= 1.6 x yardstick, <= 1.0 x input.
+   best of each; its peak RSS vs the raw file size. Goals (docs/parallel.md): <= 1.6 x yardstick, <= 1.0 x input.
 3. The same scene block-parallel (``sarcli focus --scheduler`` on a LocalCluster of 2 processes x 1
    thread started here) vs single-process: wall time, peak RSS of the client and of each worker, and
    the two images compared bit for bit.

@@ -1,4 +1,4 @@
-"""Start-up and fixed cost per command (issue 19): what a user waits for besides the processing.
+"""Start-up and fixed cost per command: what a user waits for besides the processing.
 
 Sections (one run, same machine):
   A. Warm commands (numba cache filled) as a user runs them, each a fresh process: a bare interpreter

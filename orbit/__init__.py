@@ -31,7 +31,7 @@ Public API (stable; other modules depend on it):
     (range + plane + ellipsoid at height h, Newton), ``look_angle``, ``incidence_angle``,
     ``incidence_from_look``, ``look_from_incidence``, ``slant_range_from_look``, ``look_from_slant_range``,
     ``horizon_look_angle``, ``doppler_hz``, ``doppler_rate_hz_per_s``, ``relative_velocity_eci``,
-    ``doppler_from_attitude`` (seed's fdc_orbit), ``doppler_time(sv, p, lam, fdc, t_guess=...)``,
+    ``doppler_from_attitude`` (the fdc_orbit of [Koh2003, §3.1]), ``doppler_time(sv, p, lam, fdc, t_guess=...)``,
     ``geolocate(sv, t, rho, lam, fdc, h, side)``, ``geolocate_geodetic``.
 ``orbit.propagate``
     ``Keplerian``, ``kepler_to_state``, ``propagate_j2`` (truth orbits for simulation and tests).

@@ -4,7 +4,7 @@ Every table is computed, never typed in:
 - ``hermite_table``: Hermite order N against a J2 truth orbit sampled like Radarsat-1 (15 vectors,
   480 s apart) and densely (2 s), max position/velocity error over the span, away from its ends
   (>= 2 spacings) and in the two end intervals, plus evaluations per second of the numba kernel.
-- ``attitude_table``: exact Rz(yaw) Ry(pitch) vs the seed's small-angle matrix at multiples of the
+- ``attitude_table``: exact Rz(yaw) Ry(pitch) vs the small-angle matrix of [Koh2003, eq. 1] at multiples of the
   Radarsat-1 attitude limits: pointing error (urad) and the resulting Doppler error (Hz) at C band.
 - ``frame_table``: metres at the ground if the "inertial" vectors were really in another ECI
   (true-of-date, mean-of-date, J2000) or if UT1-UTC / polar motion are neglected (bounds).
@@ -127,7 +127,7 @@ def attitude_table(scales=(0.0, 1.0, 10.0, 100.0), looks_deg=(20.0, 30.0, 40.0, 
 
     Per row, maxima over 8 orbit positions, the looks and the four sign combinations of the angles:
     ``pointing_err_urad`` angle between the two beams; ``doppler_err_hz`` = (2/lam) v_rel . (L_exact -
-    L_small) in ECI (seed eq. 4-5); ``ground_err_m`` distance between the two beams' ground points;
+    L_small) in ECI ([Koh2003, eq. 4-5]); ``ground_err_m`` distance between the two beams' ground points;
     ``attitude_doppler_hz`` the Doppler the attitude itself causes (exact beam vs zero attitude), for scale.
     """
     truth = rs1_truth() if truth is None else truth

@@ -1,16 +1,16 @@
 """Ellipsoid geometry: targets from range + Doppler (or look plane) + ellipsoid, look/incidence/range,
-Doppler of a fixed target, zero-/given-Doppler time, geolocation. Seed 002 (digest section 1).
+Doppler of a fixed target, zero-/given-Doppler time, geolocation. See [Koh2003, §2-3].
 
 Frames and conventions
     Satellite position r, velocity v and target p are in ONE Cartesian frame. For a target fixed on the
-    Earth use ECEF (then v is already the velocity relative to the rotating Earth, the seed's v_rel), or
-    ECI with v replaced by ``relative_velocity_eci(r, v)`` = v - w x r (seed eq. 5, whose printed vector
+    Earth use ECEF (then v is already the velocity relative to the rotating Earth, the v_rel of [Koh2003, eq. 4]), or
+    ECI with v replaced by ``relative_velocity_eci(r, v)`` = v - w x r ([Koh2003, eq. 5], whose printed vector
     is garbled). Angles in radians, lengths in m, times in s after the state vectors' epoch.
 Doppler sign (phase exp(-j*4*pi*R/lam), R = |p - r|):
     f_D = -(2/lam) dR/dt = (2/lam) v . (p - r)/R        (positive when the beam looks forward)
     f_R = -(2/lam) d2R/dt2,  d2R/dt2 = (|v|^2 - a.(p - r))/R - (v.(p - r))^2/R^3
-    The digest's "fdc = -(2/lam) v_rel . L" has the opposite sign; it contradicts the phase
-    convention and the digest's own f_R = -(2/lam) d2R/deta2, so it is a sign typo.
+    [Koh2003, eq. 4]'s "fdc = -(2/lam) v_rel . L" has the opposite sign; it contradicts the phase
+    convention and the paper's own (eq. 9) f_R = -(2/lam) d2R/deta2, so it is a sign typo.
 Surfaces of height h
     Solves first use the ellipsoid with semi-axes (a + h, b + h), then correct the offset with the true
     geodetic height of the solution (pyproj) until it is within 0.1 mm of h: exact heights, not the
@@ -50,7 +50,7 @@ def _norm(a):
 
 
 def relative_velocity_eci(r_eci, v_eci) -> np.ndarray:
-    """v - w x r: ECI satellite velocity relative to the rotating Earth (seed eq. 5, corrected)."""
+    """v - w x r: ECI satellite velocity relative to the rotating Earth ([Koh2003, eq. 5], corrected)."""
     r = np.asarray(r_eci, np.float64)
     v = np.asarray(v_eci, np.float64)
     return v - np.cross(np.array([0.0, 0.0, OMEGA_EARTH]), r)
@@ -197,7 +197,7 @@ def target_in_plane(r, n, c, rho, side: str = "right", h=0.0) -> np.ndarray:
     """Target p with n.(p - r) = c, |p - r| = rho, geodetic height h, on the given side of the plane's normal.
 
     ``n`` is the plane normal (along track: the relative velocity for a Doppler plane, the control
-    frame's x-axis for the seed's look plane). "right" means towards n_hat x ... i.e. the side of
+    frame's x-axis for the look plane of [Koh2003, §3.1]). "right" means towards n_hat x ... i.e. the side of
     Yf = nadir x n. All inputs broadcast; returns (..., 3). Raises :class:`GeometryError` if no such
     point exists (range too short, Doppler too large for the range, beyond the horizon).
     """
@@ -238,16 +238,16 @@ def target_from_doppler(r, v, rho, wavelength: float, fdc=0.0, side: str = "righ
 
 def target_from_look_plane(r, v, rho, pitch=0.0, yaw=0.0, side: str = "right", h=0.0,
                            exact: bool = True) -> np.ndarray:
-    """The seed's solve: |p - r| = rho, p on the surface, (p - r).w = 0 with w the control along-track axis."""
+    """Solve of [Koh2003, §3.1]: |p - r| = rho, p on the surface, (p - r).w = 0, w the control along-track axis."""
     return target_in_plane(r, along_track_axis(r, v, pitch, yaw, exact), 0.0, rho, side, h)
 
 
 def doppler_from_attitude(sv: StateVectors, t, rho, wavelength: float, pitch=0.0, yaw=0.0, side: str = "right",
                           h=0.0, exact: bool = True) -> np.ndarray:
-    """Geometric Doppler centroid (Hz) of the beam centre (seed eq. 4-6, its "fdc_orbit").
+    """Geometric Doppler centroid (Hz) of the beam centre ([Koh2003, eq. 4-6], its "fdc_orbit").
 
     At azimuth time(s) t: the target at slant range rho on the surface of height h in the control
-    frame's look plane (flight frame of the state vectors' own frame; the seed uses ECI, where zero
+    frame's look plane (flight frame of the state vectors' own frame; [Koh2003] uses ECI, where zero
     attitude means a beam perpendicular to the INERTIAL velocity), then
     fdc = (2/lam) v_rel . (p - r)/rho with v_rel = v - w x r in ECI (v in ECEF).
     """
@@ -315,7 +315,7 @@ def look_from_incidence(r, v, incidence, side: str = "right", h=0.0) -> np.ndarr
 
 
 def sphere_incidence_from_look(look, earth_radius: float, orbit_radius: float) -> np.ndarray:
-    """Spherical Earth: sin(i) = sin(look) * orbit_radius / earth_radius (seed eq. 9 chain, r+h = orbit radius)."""
+    """Spherical Earth: sin(i) = sin(look) * orbit_radius / earth_radius (r+h = orbit radius; [Koh2003, eq. 9])."""
     s = np.sin(np.asarray(look, np.float64)) * orbit_radius / earth_radius
     if np.any(s > 1):
         raise GeometryError("look angle beyond the horizon of the spherical Earth")
@@ -323,7 +323,7 @@ def sphere_incidence_from_look(look, earth_radius: float, orbit_radius: float) -
 
 
 def sphere_slant_range(incidence, earth_radius: float, orbit_radius: float) -> np.ndarray:
-    """Spherical Earth: rho = -Re cos(i) + sqrt(Re^2 cos^2(i) + H^2 + 2 Re H), H = orbit_radius - Re (seed)."""
+    """Spherical Earth: rho = -Re cos(i) + sqrt(Re^2 cos^2(i) + H^2 + 2 Re H), H = orbit_radius - Re ([Koh2003, §4])."""
     ci = np.cos(np.asarray(incidence, np.float64))
     H = orbit_radius - earth_radius
     return -earth_radius * ci + np.sqrt(earth_radius**2 * ci**2 + H * H + 2.0 * earth_radius * H)

@@ -1,19 +1,19 @@
-"""Flight and control frames and the radar beam direction (seed 002, digest section 1, eq. 2-3).
+"""Flight and control frames and the radar beam direction ([Koh2003, §2, eq. 1-3]).
 
 All functions work in whatever Cartesian frame the satellite position ``r`` and velocity ``v`` are
-given in (ECI as in the seed, or ECEF); the result is in that same frame. Arrays broadcast over
+given in (ECI as in [Koh2003], or ECEF); the result is in that same frame. Arrays broadcast over
 leading axes; vectors are (..., 3), matrices (..., 3, 3). Angles in radians.
 
 Flight frame (Xf, Yf, Zf), origin at the satellite:
     Zf = -n(r)            the geodetic nadir: minus the WGS-84 ellipsoid normal through the satellite
     Yf = Zf x v / |Zf x v|   (points to the RIGHT of the ground track)
     Xf = Yf x Zf             (along track, forward; equals v/|v| when v is horizontal)
-The seed builds n(r) as s/|s| with s = (rx, ry, rz + dz), dz = rho*(tan(phi_gd) - tan(phi_gc)),
+[Koh2003, eq. 2] builds n(r) as s/|s| with s = (rx, ry, rz + dz), dz = rho*(tan(phi_gd) - tan(phi_gc)),
 rho = sqrt(rx^2 + ry^2): the ellipsoid normal through r meets the Z axis at z = rz - rho*tan(phi_gd), so
 s = (rx, ry, rho*tan(phi_gd)) is parallel to (cos(lon) cos(phi_gd), sin(lon) cos(phi_gd), sin(phi_gd)).
 We evaluate that last form (identical, and finite at the poles where tan diverges); phi_gd comes from
-pyproj. The seed prints Zf = s/|s| with minus signs in its components: the minus is right (digest).
-Q = [Xf Yf Zf] (columns) maps flight-frame coordinates to the frame of r; the seed's printed eq. 2
+pyproj. [Koh2003, eq. 2] prints Zf = s/|s| with minus signs in its components: the minus is right.
+Q = [Xf Yf Zf] (columns) maps flight-frame coordinates to the frame of r; the printed [Koh2003, eq. 2]
 matrix has placeholder typos and is not used.
 
 Control frame: the flight frame rotated by the attitude, R = Rz(yaw) Ry(pitch) (roll is absorbed in
@@ -21,12 +21,12 @@ the look angle), active rotations about the flight axes:
     Rz(y) = [[cos y, -sin y, 0], [sin y, cos y, 0], [0, 0, 1]],
     Ry(p) = [[cos p, 0, sin p], [0, 1, 0], [-sin p, 0, cos p]],
     exact:        R = [[cy cp, -sy, cy sp], [sy cp, cy, sy sp], [-sp, 0, cp]]
-    small-angle:  R ~ [[1, -y, p], [y, 1, 0], [-p, 0, 1]]          (seed's matrix; first order in p, y)
+    small-angle:  R ~ [[1, -y, p], [y, 1, 0], [-p, 0, 1]]          ([Koh2003, eq. 1]; first order in p, y)
 Positive pitch turns the beam forward (+Xf), positive yaw turns a right-looking beam backward.
 
 Beam direction in the control frame for look angle gamma (from nadir): Lc = (0, s sin(gamma),
-cos(gamma)) with s = +1 right-looking, -1 left-looking; in the frame of r: L = Q R Lc (seed eq. 3).
-The along-track (look-plane normal) axis is w = Q R e_x, the FIRST COLUMN of Q R (the digest's "first
+cos(gamma)) with s = +1 right-looking, -1 left-looking; in the frame of r: L = Q R Lc ([Koh2003, eq. 3]).
+The along-track (look-plane normal) axis is w = Q R e_x, the FIRST COLUMN of Q R ([Koh2003, §3.1]'s "first
 row" would be the control axes' x components, a transposition typo).
 """
 
@@ -76,7 +76,7 @@ def flight_frame(r: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def control_rotation(pitch, yaw, exact: bool = True) -> np.ndarray:
-    """R (..., 3, 3) from the control to the flight frame: Rz(yaw) Ry(pitch), or the seed's small-angle form."""
+    """R (..., 3, 3) from the control to the flight frame: Rz(yaw) Ry(pitch), or [Koh2003]'s small-angle form."""
     p = np.asarray(pitch, np.float64)
     y = np.asarray(yaw, np.float64)
     p, y = np.broadcast_arrays(p, y)
@@ -96,9 +96,9 @@ def look_vector_control(look, side: str = "right") -> np.ndarray:
 
 
 def beam_vector(r, v, look, pitch=0.0, yaw=0.0, side: str = "right", exact: bool = True) -> np.ndarray:
-    """L = Q R Lc (..., 3): unit beam-pointing vector in the frame of r, v (seed eq. 3).
+    """L = Q R Lc (..., 3): unit beam-pointing vector in the frame of r, v ([Koh2003, eq. 3]).
 
-    For an ECI state this is the seed's ECI beam vector; rotate it to ECEF like a position
+    For an ECI state this is the ECI beam vector of [Koh2003, eq. 3]; rotate it to ECEF like a position
     (``orbit.frames.eci_to_ecef`` without velocity), or pass an ECEF state to get it in ECEF directly
     (note: the flight frame then follows the ECEF velocity, which differs from the ECI one by w x r).
     """
@@ -107,7 +107,7 @@ def beam_vector(r, v, look, pitch=0.0, yaw=0.0, side: str = "right", exact: bool
 
 
 def along_track_axis(r, v, pitch=0.0, yaw=0.0, exact: bool = True) -> np.ndarray:
-    """w = Q R e_x (..., 3): the control frame's along-track axis, normal of the seed's look plane."""
+    """w = Q R e_x (..., 3): the control frame's along-track axis, normal of the look plane of [Koh2003, §3.1]."""
     return (flight_frame(r, v) @ control_rotation(pitch, yaw, exact))[..., :, 0]
 
 

@@ -3,8 +3,8 @@
 Interpolant
 -----------
 Over a window of N consecutive nodes t_0..t_{N-1} with positions p_i and velocities v_i, the Hermite
-interpolant H is the unique polynomial of degree 2N-1 with H(t_i) = p_i and H'(t_i) = v_i (seed 002:
-"Hermite, i.e. using both positions and velocities"). Its error for a smooth orbit r(t) is
+interpolant H is the unique polynomial of degree 2N-1 with H(t_i) = p_i and H'(t_i) = v_i ([Koh2003, §2.1]:
+Hermite interpolation, i.e. using both positions and velocities). Its error for a smooth orbit r(t) is
 
     r(t) - H(t) = r^(2N)(xi) / (2N)! * prod_i (t - t_i)^2 ,
 

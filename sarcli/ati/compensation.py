@@ -1,6 +1,6 @@
-"""Compensating every estimated mover of an ATI pair and measuring where it lands (seed 001 §4).
+"""Compensating every estimated mover of an ATI pair and measuring where it lands ([Ryu2017, §IV]).
 
-Each mover's slow-time signal is compensated (``pipeline.compensate``, H_ph of seed eq. 20 with the
+Each mover's slow-time signal is compensated (``pipeline.compensate``, H_ph of [Ryu2017, eq. 20] with the
 chosen method) and re-compressed; the compensated movers are added one after the other into the
 channel-0 image. Per mover the record gives, in the LOCAL frame (y along track, m):
 

@@ -1,4 +1,4 @@
-"""Mover detection on a co-registered two-channel image pair (seed 001, step 2).
+"""Mover detection on a co-registered two-channel image pair ([Ryu2017, Fig. 2], step 2).
 
 Interferogram ``I = Z1 * conj(Z0)`` (channel 1 = the receiver ahead; stationary scatterers have
 phase ``phi_c`` = the bistatic excess -(4*pi/lam)*d^2/(8*R), a mover ``phi_c`` + its ATI phase).

@@ -1,4 +1,4 @@
-"""Mover parameters (vx, vy, x0, y0) from its two-channel slow-time signals (seed 001, §3).
+"""Mover parameters (vx, vy, x0, y0) from its two-channel slow-time signals ([Ryu2017, §III]).
 
 Input (:class:`SlowTime`): the slow-time signals of the mover's range bin in channel 0 (the
 monostatic channel, receiver on the transmitter, range history R(eta) of
@@ -20,7 +20,7 @@ Data reduced from the signals:
   (4*pi/lam)*d**2/(8*R) (half-sum of transmit and receive ranges exceeds the phase-centre range).
 
 Routes (knob ``route``):
-``seed``      the paper's chain with the printed typos fixed: quadratic LS at eta = 0 -> vR, aR;
+``seed``      the chain of [Ryu2017, §III] with the printed typos fixed: quadratic LS at eta = 0 -> vR, aR;
               R0 = mean r_track; vx = vr_los*R0/x0 from the mean ATI phase (neglects vy*y/R over the
               aperture, as the paper does); vy = Vp - sqrt(R0*aR - vx^2) (eq. 15 with aR the full
               second derivative; drops vR^2); azimuth angle phi = (vR/cos_g)/(vy - Vp) (eq. 17 with
@@ -269,8 +269,8 @@ def estimate(obs: SlowTime, route: str = "exact", unwrap_method: str = "dechirp"
     """Estimate the mover's parameters by ``route`` (see module docstring).
 
     ``degree`` is the polynomial degree of the range-history fit of the ``exact`` route (2 = the
-    seed's quadratic; 4 removes the quartic-term bias of R'' over long apertures). The ``seed``
-    route always fits the seed's quadratic.
+    quadratic of [Ryu2017, eq. 13]; 4 removes the quartic-term bias of R'' over long apertures). The ``seed``
+    route always fits the quadratic of [Ryu2017, eq. 13].
     """
     if route not in ROUTES:
         raise SarcliError(f"unknown estimation route {route!r}; choose one of {', '.join(ROUTES)}")

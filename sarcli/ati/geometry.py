@@ -1,27 +1,27 @@
-"""Flat-Earth range history of a ground moving target and its inversion (seed 001, digest §2).
+"""Flat-Earth range history of a ground moving target and its inversion ([Ryu2017, §II]).
 
 Frame (the simulator's LOCAL frame): x cross-track ground range (+x on the right of the flight
 direction), y along-track, z up. Slow time ``eta`` (s) is counted from the reference time at which
 the platform is at ``(0, 0, H)`` and the target at ``(x0, y0, 0)``:
 
     platform  r1(eta) = (0, Vp*eta, H)
-    target    r2(eta) = (x0 + vx*eta, y0 + vy*eta, 0)         (seed eq. 3 fixed: target on the ground)
+    target    r2(eta) = (x0 + vx*eta, y0 + vy*eta, 0)         ([Ryu2017, eq. 3] fixed: target on the ground)
 
 With ``u = vy - Vp`` (relative along-track velocity) and ``V2 = vx**2 + u**2``:
 
     R(eta)**2 = R0**2 + 2*R0*vR*eta + V2*eta**2                (exactly quadratic)
     R0 = sqrt(x0**2 + y0**2 + H**2),   vR = (vx*x0 + u*y0)/R0
-    aR = d2R/deta2 at 0 = (V2 - vR**2)/R0                       (exact; seed eq. 4 prints
+    aR = d2R/deta2 at 0 = (V2 - vR**2)/R0                       (exact; [Ryu2017, eq. 4] prints
                                                                  (vx**2+u**2)/(2*R0): drops vR**2 and
                                                                  mixes in the 1/2 of eq. 2)
 
 so ``R(eta) = R0 + vR*eta + aR*eta**2/2 + O(eta**3)``; in this module ``aR`` is always the full
-second derivative. Split (seed eq. 5-7) ``R = Rs + Rm`` with ``Rs`` the range history of a
+second derivative. Split ([Ryu2017, eq. 5-7]) ``R = Rs + Rm`` with ``Rs`` the range history of a
 *stationary* point at (x0, y0) (what a stationary-scene RDA matches) and ``Rm`` the rest:
 
     vs = -y0*Vp/R0,            as = (Vp**2 - vs**2)/R0
     vm = vR - vs = (vx*x0 + vy*y0)/R0
-    am = aR - as = (vx**2 + vy**2 - 2*vy*Vp - vR**2 + vs**2)/R0  (seed eq. 7 drops -vR**2 + vs**2)
+    am = aR - as = (vx**2 + vy**2 - 2*vy*Vp - vR**2 + vs**2)/R0  ([Ryu2017, eq. 7] drops -vR**2 + vs**2)
 
 ``vm`` displaces the mover in azimuth by about ``-R0*vm/Vp``; ``am`` defocuses it. The
 "conventional" compensation replaces ``vm`` by ``vx*x0/R0`` (neglects ``vy*y0/R0``).
@@ -34,7 +34,7 @@ target with line-of-sight range rate ``vr_los`` (positive = receding) gives
     phi_ATI = arg(Z_fore * conj(Z_aft)) = +(4*pi/lam) * vr_los * d/(2*Vp)
 
 with our phase convention exp(-j*4*pi*R/lam) (fore = the receiver ahead along-track). A ground
-velocity vx maps to ``vr_los = vx * x0/R0`` (x0/R0 = sin of the look angle; the seed's eq. 10-11
+velocity vx maps to ``vr_los = vx * x0/R0`` (x0/R0 = sin of the look angle; [Ryu2017, eq. 10-11]
 write ``cos(theta)`` for an angle measured from the horizontal and use ``d`` instead of ``d/2``).
 """
 

@@ -1,4 +1,4 @@
-"""Monte-Carlo of the estimation chain vs SNR (seed 001, Fig. 9): simulate -> focus -> detect -> estimate.
+"""Monte-Carlo of the estimation chain vs SNR ([Ryu2017, Fig. 9]): simulate -> focus -> detect -> estimate.
 
 Every run re-simulates the scene through ``sarcli.sim`` with the ``noise`` effect at the run's SNR
 and a run seed drawn from ``numpy.random.SeedSequence([seed, snr_index, run])`` (reproducible from

@@ -140,7 +140,7 @@ def slow_time(pair: Pair, c: Candidate, bin_mode: str = "track") -> tuple[SlowTi
     rows, cols = _window(pair, c)
     s0 = decompress(pair.slc0, pair.z0, rows, cols)
     s1 = decompress(pair.slc0, pair.z1, rows, cols)
-    # Range bin: the seed's minimum ANV, computed on the clutter-cancelled (DPCA) signal (stationary
+    # Range bin: the minimum ANV of [Ryu2017, eq. 12], computed on the clutter-cancelled (DPCA) signal (stationary
     # scatterers in the window also have a constant slow-time amplitude but cancel in
     # s1 - s0*exp(j*phi_c)), among the bins within +-3 of the detected peak (at low SNR the DPCA
     # signal, ~phi_ATI^2 weaker than s0, is noise-dominated away from the mover).
@@ -173,12 +173,12 @@ def estimate_mover(pair: Pair, c: Candidate, route: str = "exact", unwrap_method
 
 
 def compensation_phase(eta: np.ndarray, e: Estimate, platform: Platform, method: str = "exact") -> np.ndarray:
-    """Phase (rad) of H_ph(eta) (seed eq. 20, our sign convention: multiply to remove Rm).
+    """Phase (rad) of H_ph(eta) ([Ryu2017, eq. 20], our sign convention: multiply to remove Rm).
 
     exact:        +(4*pi/lam)*(R(eta) - Rs(eta)) with the estimated mover and the stationary point
                   at its estimated (x0, y0) (removes Rm to all orders);
     quadratic:    +(4*pi/lam)*(vm*eta + am*eta^2/2) (eq. 20 with the 1/2 of eq. 6 restored; exact vm, am);
-    conventional: as quadratic with vm -> vx*x0/R0 (neglects vy*y0/R0, refs [3]-[7] of the seed).
+    conventional: as quadratic with vm -> vx*x0/R0 (neglects vy*y0/R0, refs [3]-[7] of [Ryu2017]).
     """
     if method not in COMPENSATIONS:
         raise SarcliError(f"unknown compensation {method!r}; choose one of {', '.join(COMPENSATIONS)}")

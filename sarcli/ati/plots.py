@@ -1,4 +1,4 @@
-"""PNG figures of the ATI commands: azimuth PSFs (seed Figs. 5b, 8) and Monte-Carlo errors (Fig. 9)."""
+"""PNG figures of the ATI commands: azimuth PSFs ([Ryu2017, Figs. 5b, 8]) and Monte-Carlo errors (Fig. 9)."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def psf_plot(profiles: dict[str, tuple[np.ndarray, np.ndarray]], path: str | os.
 
 
 def montecarlo_plot(result: dict, path: str | os.PathLike) -> None:
-    """Relative error (%) of vy, x0, y0 vs SNR, mean and max (like the seed's Fig. 9)."""
+    """Relative error (%) of vy, x0, y0 vs SNR, mean and max (like [Ryu2017, Fig. 9])."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -1,4 +1,4 @@
-"""Between RD-focused images and a mover's slow-time signal (seed 001, steps 3-4 and eq. 21).
+"""Between RD-focused images and a mover's slow-time signal ([Ryu2017, Fig. 2, steps 3-4, and eq. 21]).
 
 The RDA (``sarcli.focus.rda``) forms, per range bin i with closest range R0_i, effective velocity
 V_i, centroid fdc_i and integer line shift ``shift``, the SLC ``Z = IFFT_az[ W * P * RCMC(S) ]`` with
@@ -7,7 +7,7 @@ the azimuth reference phase (see ``sarcli.focus.rcmc``)
     P_i(f) = exp(+j*4*pi*R0_i*(D_i(f) - 1)/lam + j*pi/4 - j*2*pi*f_bin*shift/PRF),
     D_i(f) = sqrt(1 - (lam*f/(2*V_i))**2),  f = fdc_i + wrap(f_bin - fdc_i)
 
-and the window W. Hence the RCMC'd, range-compressed slow-time signal of a sub-image (the seed's
+and the window W. Hence the RCMC'd, range-compressed slow-time signal of a sub-image ([Ryu2017]'s
 s_RDA) is ``IFFT_az[ FFT_az(Z_sub) * conj(P) ]`` (the window stays as a taper), and a corrected
 slow-time signal is re-compressed with ``IFFT_az[ FFT_az(s) * P ]``. Both transforms run on a
 zero-padded grid (the image at offset ``n_lines//2``) so that nothing wraps around.
@@ -16,7 +16,7 @@ Channel co-registration (DRA): receiver k at along-track offset d_k has its effe
 d_k/2 ahead, so its image shows every scatterer d_k/(2*Vp) s EARLIER; it is delayed by that much in
 the azimuth-frequency domain (``exp(-j*2*pi*f*delay)``).
 
-ANV (seed eq. 12): ``1 - mean(|s_n|)**2 / mean(|s_n|**2)``: 0 for a constant-amplitude signal,
+ANV ([Ryu2017, eq. 12]): ``1 - mean(|s_n|)**2 / mean(|s_n|**2)``: 0 for a constant-amplitude signal,
 1 - pi/4 = 0.215 for Gaussian noise; the bin with the smallest value holds the mover.
 """
 
@@ -92,7 +92,7 @@ def coregister(slc, image: np.ndarray, delay_s: float) -> np.ndarray:
 
 
 def anv(slow: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
-    """Amplitude-normalized variance per column (seed eq. 12), over rows with weight > 0."""
+    """Amplitude-normalized variance per column ([Ryu2017, eq. 12]), over rows with weight > 0."""
     a = np.abs(slow)
     w = np.ones(a.shape[0]) if weights is None else np.asarray(weights, np.float64)
     m1 = np.average(a, axis=0, weights=w)
@@ -118,7 +118,7 @@ def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4, smooth: int = 63)
 
     A mover's range history differs from the stationary one the RCMC assumes, so it drifts by a
     few range bins over a long aperture (R'^2*R*(1/V^2 - 1/Vp^2)/2, ~2.4 m at the start of the
-    paper's CPI); a single bin (the seed's ANV choice) then loses it and picks up the phase of
+    paper's CPI); a single bin (the ANV choice of [Ryu2017, eq. 12]) then loses it and picks up the phase of
     the compressed pulse's sidelobes. Within the mainlobe the phase of the compressed pulse is
     flat, so the sample at the track carries the mover's phase. The per-row peaks (parabolic
     interpolation of the magnitude) are median-filtered over ``smooth`` rows so that noise peaks
@@ -140,5 +140,5 @@ def track_peak(slow: np.ndarray, col: int, halfwidth: int = 4, smooth: int = 63)
 
 
 def single_bin(slow: np.ndarray, col: int) -> tuple[np.ndarray, np.ndarray]:
-    """The seed's choice: one range bin for all rows (signal and its constant column)."""
+    """The choice of [Ryu2017, eq. 12]: one range bin for all rows (signal and its constant column)."""
     return slow[:, col], np.full(slow.shape[0], float(col))

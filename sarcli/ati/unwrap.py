@@ -1,4 +1,4 @@
-"""Phase unwrapping of a mover's slow-time signal (seed 001, step 5), two methods as a knob.
+"""Phase unwrapping of a mover's slow-time signal ([Ryu2017, Fig. 2], step 5), two methods as a knob.
 
 ``itoh``    the textbook 1-D unwrap (numpy.unwrap): add 2*pi wherever consecutive samples jump by
             more than pi. Exact when the noise-free phase changes by < pi per sample and the noise is

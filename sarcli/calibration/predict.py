@@ -21,7 +21,7 @@ Corrections not in the geometry (a metre-level offset is only a geometry error a
   0.25 m per TEC unit (1e16 m^-2) at 1.27 GHz, vertical; slant through a thin shell at 350 km, i.e.
   divided by cos(theta_ion), sin(theta_ion) = sin(theta_i) Re / (Re + 350 km). Typical TEC 5-50 TECU:
   metres at L-band (and azimuth shifts where TEC varies along track). Needs a TEC map; not applied.
-- solid-earth tide: up to ~0.3 m vertical, ~0.05 m horizontal [Petit2010, ch. 7]: up to ~0.25 m in
+- solid-earth tide: up to ~0.3 m vertical, ~0.05 m horizontal [IERS2010, ch. 7]: up to ~0.25 m in
   slant range. Needs the IERS model; not applied.
 - processor conventions: the azimuth time reference (the sensor moves v R / c, ~20 m, during the
   two-way travel time; stop-and-go processors absorb it in their timing, others do not), range

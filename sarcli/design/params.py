@@ -10,12 +10,12 @@ A design TOML (see ``samples/aod_ccd_example.toml``)::
     altitude_m = 5000.0
     velocity_mps = 250.0
     look_angle_deg = 30.0
-    look_angle_from = "horizontal"   # "horizontal" (depression, the seed's convention) or "nadir"
+    look_angle_from = "horizontal"   # "horizontal" (depression, the convention of [KimAODCCD]) or "nadir"
     squint_angle_deg = 90.0          # angle between velocity and line of sight (90 = broadside)
     antenna_length_m = 2.0           # optional: real antenna (azimuth), enables PRF > 2v/D
     swath_slant_m = 4000.0           # optional: else from the AOD aperture, else 0
     prf_hz = [15734, 3934, 1967]
-    [design.processor]               # optional: the AOD/CCD optical processor of seed 004
+    [design.processor]               # optional: the AOD/CCD optical processor of [KimAODCCD]
     ccd_rows = 491
     ccd_line_rate_hz = 15734.0
     aod_aperture_m = 0.031
@@ -45,7 +45,7 @@ PLATFORMS = ("airborne", "spaceborne", "gbsar")
 
 @dataclass(frozen=True)
 class Processor:
-    """The AOD/CCD optical processor of seed 004 (all optional): CCD rows and line rate, AOD aperture (m)
+    """The AOD/CCD optical processor of [KimAODCCD] (all optional): CCD rows and line rate, AOD aperture (m)
     and acoustic velocity (m/s)."""
 
     ccd_rows: int | None = None

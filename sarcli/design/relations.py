@@ -1,4 +1,4 @@
-"""Design relations of seed 004 (§2 "SAR design concept"), derived in this module's notation.
+"""Design relations of [KimAODCCD, §2.4 "SAR design concept"], derived in this module's notation.
 
 Notation: c speed of light, B chirp bandwidth (Hz), K chirp rate (Hz/s), tau pulse length (s),
 lam wavelength, R slant range, H platform height, v platform speed, D real antenna length (azimuth),
@@ -26,7 +26,7 @@ def slant_range_resolution(bandwidth_hz: float, c: float = C_LIGHT) -> float:
 
 def ground_range_resolution(bandwidth_hz: float, incidence_rad: float, c: float = C_LIGHT) -> float:
     """delta_Rg = c / (2 B sin(i)) with i the incidence angle at the ground (flat Earth: i = 90 deg -
-    depression). Seed eq. 14 writes c/(2 B cos a) with a the side-looking angle measured from the
+    depression). [KimAODCCD, eq. 14] writes c/(2 B cos a) with a the side-looking angle measured from the
     horizontal: cos(a) = sin(i), the same relation."""
     return c / (2.0 * bandwidth_hz * math.sin(incidence_rad))
 
@@ -63,7 +63,7 @@ def look_angle_for_slant_range(height_m: float, slant_range_m: float, earth_radi
 
 def azimuth_resolution(wavelength_m: float, slant_range_m: float, aperture_m: float,
                        theta_sq_rad: float = math.pi / 2) -> float:
-    """delta_az = lam R / (2 L sin(theta_sq)) (seed eq. 15, R_y = lam R0 / (2 L sin(theta))).
+    """delta_az = lam R / (2 L sin(theta_sq)) ([KimAODCCD, eq. 15], R_y = lam R0 / (2 L sin(theta))).
 
     The aperture L seen from the target spans the angle L sin(theta_sq)/R across the line of sight;
     two-way phase doubles the angular diversity: delta_az = lam / (2 * angle). Broadside: sin = 1."""
@@ -77,7 +77,7 @@ def beam_limited_aperture(wavelength_m: float, slant_range_m: float, antenna_len
 
 def prf_min_azimuth(velocity_mps: float, antenna_length_m: float) -> float:
     """PRF > 2 v / D: the Doppler bandwidth of the real beam, 2 v (lam/D) / lam, must be sampled
-    without aliasing (seed: "2v/l < PRF", l the antenna length)."""
+    without aliasing ([KimAODCCD, §2.4]: "2v/l < PRF", l the antenna length)."""
     return 2.0 * velocity_mps / antenna_length_m
 
 
@@ -89,7 +89,7 @@ def processed_doppler_bandwidth(velocity_mps: float, azimuth_resolution_m: float
 
 def prf_max_range(max_slant_range_m: float, c: float = C_LIGHT) -> float:
     """PRF < c / (2 R_max): the echo of the farthest point must return before the next pulse leaves
-    (seed's relation; one pulse in flight)."""
+    ([KimAODCCD, §2.4]'s relation; one pulse in flight)."""
     return c / (2.0 * max_slant_range_m)
 
 
@@ -103,7 +103,7 @@ def ccd_doppler_samples(ccd_rows: int, ccd_line_rate_hz: float, prf_hz: float) -
     """Pulses integrated by a CCD azimuth correlator.
 
     The CCD shifts its charge by one row per line clock (``ccd_line_rate_hz``; 15734 Hz is the NTSC
-    line rate the seed's PRFs are sub-multiples of) and integrates over ``ccd_rows - 1`` shifts, i.e.
+    line rate the PRFs of [KimAODCCD, §2.4] are sub-multiples of) and integrates over ``ccd_rows - 1`` shifts, i.e.
     a fixed aperture time T = (rows - 1)/line_rate; a pulse arrives every line_rate/PRF shifts, so
     N = floor((rows - 1) * PRF / line_rate): 490, 122, 61 at 15734, 3934, 1967 Hz with 491 rows.
     """
@@ -123,7 +123,7 @@ def aod_swath(aod_aperture_m: float, acoustic_velocity_mps: float, pulse_length_
 
 def stepped_frequency_max_range(frequency_step_hz: float, c: float = C_LIGHT) -> float:
     """GB-SAR: R_max = c / (4 df) — the inverse FFT of N frequency steps df spans a two-way delay
-    1/df, i.e. c/(2 df) of range; seed 000 keeps half of it to avoid the negative-time half."""
+    1/df, i.e. c/(2 df) of range; [LeeGBSAR-II-2007, §2.1] keeps half of it to avoid the negative-time half."""
     return c / (4.0 * frequency_step_hz)
 
 

@@ -86,7 +86,7 @@ def evaluate(p: DesignParams) -> dict[str, Any]:
         ]
         if p.antenna_length_m:
             cons.append(_constraint("azimuth_resolution_limit", az >= p.antenna_length_m / 2 - 1e-9, az,
-                                    p.antenna_length_m / 2, "delta_az >= D/2 (seed eq. 16)"))
+                                    p.antenna_length_m / 2, "delta_az >= D/2 ([KimAODCCD, eq. 16])"))
         options.append({
             "prf_hz": prf, "doppler_samples": n, "aperture_time_s": t_ap, "synthetic_aperture_m": aperture,
             "azimuth_resolution_m": az, "azimuth_resolution_broadside_m": rel.azimuth_resolution(lam, slant, aperture),
@@ -95,7 +95,7 @@ def evaluate(p: DesignParams) -> dict[str, Any]:
         })
     if p.squint_angle_deg != 90.0:
         notes.append(f"azimuth resolution uses sin({p.squint_angle_deg:g} deg) of the velocity-to-line-of-sight "
-                     f"angle (seed eq. 15); a broadside side-looking radar has 90 deg: "
+                     f"angle ([KimAODCCD, eq. 15]); a broadside side-looking radar has 90 deg: "
                      f"{options[0]['azimuth_resolution_broadside_m']:.2f} m")
     first = options[0]
     return {

@@ -16,7 +16,7 @@ Modules, one job each:
                  unwrapping of the baseband centroid over blocks.
 - ``polyfit``    weighted 2-D polynomial fit (range x azimuth) with outlier flags.
 - ``dataonly``   MLCC / MLBF data-only ambiguity resolution with an honest confidence.
-- ``geometry``   fdc and fr from orbit + attitude (full vector form and the seed's closed form eq. 6,
+- ``geometry``   fdc and fr from orbit + attitude (full vector form and the closed form [Koh2003, eq. 6],
                  look-angle inversion, exact -(2/lam) d2R/deta2) over the terrain under the beam.
 - ``lookbalance`` the look-balance centroid (used by the ``lb`` estimator).
 - ``mapdrift``   data-driven Doppler rate by map-drift autofocus.

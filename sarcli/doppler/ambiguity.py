@@ -1,6 +1,6 @@
-"""PRF ambiguity of the Doppler centroid (seed eq. 7-8, with margins and the half-integer case).
+"""PRF ambiguity of the Doppler centroid ([Koh2003, eq. 7-8], with margins and the half-integer case).
 
-The data give the centroid modulo the PRF: fdc = fdc_bb + n * PRF. Seed eq. 7 rounds each block
+The data give the centroid modulo the PRF: fdc = fdc_bb + n * PRF. [Koh2003, eq. 7] rounds each block
 independently, n = round((fdc_pred - fdc_bb) / PRF). Two things go wrong with that near a rounding
 boundary: neighbouring blocks can flip between n and n+1, and ``round`` of an exact half-integer is
 undefined (numpy rounds to even). Here instead

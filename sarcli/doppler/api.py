@@ -1,5 +1,5 @@
 """``estimate_doppler(raw) -> PolyDoppler``: the absolute Doppler centroid and the Doppler rate of a raw
-product (the seed's hybrid method, plus data-only routes).
+product ([Koh2003]'s hybrid method, plus data-only routes).
 
 The stages are in :mod:`sarcli.doppler.pipeline`, the centroid estimators in
 :mod:`sarcli.doppler.estimators` (plug-ins), the knobs in :class:`~sarcli.doppler.options.DopplerOptions`.

@@ -2,7 +2,7 @@
 
 For a block of complex samples h(m, k) (azimuth line m, range sample k) the lag-1 azimuth correlation
 
-    C = sum_{m,k} h(m+1, k) * conj(h(m, k))                       (seed digest §1, "CDE")
+    C = sum_{m,k} h(m+1, k) * conj(h(m, k))                       ([Madsen1989]; [Koh2003, §3.2])
 
 has phase 2*pi*fdc/PRF for a stationary azimuth signal whose power spectrum is centred on fdc, so
 ``fdc_baseband = PRF * arg(C) / (2*pi)`` in [-PRF/2, PRF/2). The pairs are taken inside the block
@@ -253,7 +253,7 @@ def block_correlation(echo: np.ndarray, az_block: int = 2048, rg_block: int = 12
     """Lag-``lag`` azimuth correlation sums per block (numba). ``estimator`` is "cde" or "sde".
     (The CDE uses lag 1; longer lags serve MLBF, whose phase is then ``lag`` times larger.)
 
-    Default block (2048 azimuth x 128 range) is the seed paper's. NaN/inf input raises SarcliError.
+    Default block (2048 azimuth x 128 range) is that of [Koh2003, §5]. NaN/inf input raises SarcliError.
     """
     if estimator not in ("cde", "sde"):
         raise SarcliError(f"unknown correlation estimator {estimator!r} (use cde or sde)")

@@ -1,30 +1,30 @@
-"""Doppler centroid and rate from orbit + attitude (seed 002 eq. 4-6 and 9, corrected).
+"""Doppler centroid and rate from orbit + attitude ([Koh2003, eq. 4-6 and 9], corrected).
 
 Sign (project phase convention exp(-j*4*pi*R/lam), see ``orbit.geometry``):
     fdc = -(2/lam) dR/deta = +(2/lam) v_rel . L,   fr = -(2/lam) d2R/deta2,
 with L the unit line of sight satellite -> target and v_rel the satellite velocity relative to the
-(Earth-fixed) target. The seed/digest's "-(2/lam) v_rel . L" has the opposite sign (typo).
+(Earth-fixed) target. [Koh2003, eq. 4]'s "-(2/lam) v_rel . L" has the opposite sign (typo).
 
 Full vector model (``fdc_vector``): at azimuth time eta, the target p is the point of the ellipsoid
 (+ height) at slant range rho in the beam-centre plane (p - r) . w = 0, w = Q R e_x the control
-frame's along-track axis (attitude pitch/yaw; flight frame Q from the ECI state, seed eq. 2-3), and
+frame's along-track axis (attitude pitch/yaw; flight frame Q from the ECI state, [Koh2003, eq. 2-3]), and
 fdc = (2/lam) (v - w_e x r) . (p - r)/rho, exact because (w_e x (p - r)) . (p - r) = 0
 (``orbit.geometry.doppler_from_attitude``).
 
-Closed form (``fdc_closed``, the seed's eq. 6 in our notation): with R Lc expanded to first order in
+Closed form (``fdc_closed``, [Koh2003, eq. 6] in our notation): with R Lc expanded to first order in
 pitch pp and yaw py, R Lc = (pp cos g - s py sin g, s sin g, cos g) (s = +1 right-looking), and
-v_rel approximated by the satellite-position form v - w_e x r (seed eq. 5), projected on the flight
+v_rel approximated by the satellite-position form v - w_e x r ([Koh2003, eq. 5]), projected on the flight
 axes V_k = v_rel . {Xf, Yf, Zf}:
 
     fdc(g) = A cos g + B sin g,   A = (2/lam) (V_z + pp V_x),   B = (2/lam) s (V_y - py V_x)     (eq. 6)
 
-where g is the look angle of the slant range in the cross-track plane. Its inversion for the seed's
+where g is the look angle of the slant range in the cross-track plane. Its inversion for [Koh2003]'s
 fr route (eq. 9 chain) is g = phi +- acos(fdc / C), C = sqrt(A^2 + B^2), phi = atan2(B, A) (equivalent
 to the printed g = asin(alpha f +- beta sqrt(alpha^2 + beta^2 - f^2)) with alpha = B/C^2, beta = A/C^2);
 the root in (0, pi/2) closest to the look angle of the block's slant range is kept; |fdc| > C (sqrt
 domain) or no root in (0, pi/2) (asin domain) is reported as NaN, never clipped silently. Then the
 spherical incidence i = asin(sin g (r + h)/r) and slant range rho = -r cos i + sqrt(r^2 cos^2 i + h^2
-+ 2 r h) (seed, ``orbit.geometry.sphere_*``), and fr is evaluated exactly for the target at p = r + rho L(g)
++ 2 r h) ([Koh2003, §4], ``orbit.geometry.sphere_*``), and fr is evaluated exactly for the target at p = r + rho L(g)
 (the printed coefficients f_0, f_s, f_c, f_phi of eq. 9 contain typos and are not used).
 
 Exact rate (``fr_exact``): the target at slant range rho with the ABSOLUTE centroid fdc on the
@@ -216,7 +216,7 @@ class OrbitGeometry:
             raise SarcliError(f"geometry: {e}") from None
 
     def fdc_closed(self, rho, t, h=None) -> np.ndarray:
-        """Seed eq. 6 (corrected, module docstring): A cos g + B sin g, g from the slant range on the
+        """[Koh2003, eq. 6] (corrected, module docstring): A cos g + B sin g, g from the slant range on the
         surface of height h (default: the terrain's)."""
         rho, t = np.broadcast_arrays(np.asarray(rho, np.float64), np.asarray(t, np.float64))
         h = self._height(rho, t, h)
@@ -227,7 +227,7 @@ class OrbitGeometry:
         return A * np.cos(g) + B * np.sin(g)
 
     def look_from_fdc(self, fdc, rho, t, h=None) -> np.ndarray:
-        """Seed inversion of eq. 6 for the look angle (rad); NaN outside the sqrt/asin domains."""
+        """Inversion of [Koh2003, eq. 6] for the look angle (rad); NaN outside the sqrt/asin domains."""
         fdc, rho, t = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, rho, t)))
         h = self._height(rho, t, h)
         r, v, _, _, _ = self._states(t)
@@ -248,7 +248,7 @@ class OrbitGeometry:
         return og.doppler_rate_hz_per_s(re, ve, ae, p, self.wavelength)
 
     def fr_seed(self, fdc, rho, t, h=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Seed route: look angle re-solved from fdc (eq. 6 inverse), spherical incidence and slant
+        """Route of [Koh2003, §4]: look angle re-solved from fdc (eq. 6 inverse), spherical incidence and slant
         range, then the exact rate at that target. Returns (fr Hz/s, look rad, slant range m); NaN
         where the inversion leaves its domain."""
         fdc, rho, t = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, rho, t)))
@@ -277,7 +277,7 @@ class OrbitGeometry:
 
 def invert_closed_form(fdc, A, B, look_hint) -> np.ndarray:
     """Roots g of A cos g + B sin g = fdc in (0, pi/2), the one closest to ``look_hint``; NaN when
-    |fdc| > sqrt(A^2 + B^2) (the seed's sqrt domain) or no root lies in (0, pi/2) (its asin domain)."""
+    |fdc| > sqrt(A^2 + B^2) (the sqrt domain of [Koh2003, §4]) or no root lies in (0, pi/2) (its asin domain)."""
     fdc, A, B, hint = np.broadcast_arrays(*(np.asarray(x, np.float64) for x in (fdc, A, B, look_hint)))
     C = np.hypot(A, B)
     phi = np.arctan2(B, A)

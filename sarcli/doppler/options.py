@@ -21,7 +21,7 @@ class DopplerOptions:
     """Knobs of :func:`sarcli.doppler.api.estimate_doppler` (units in the names; defaults and why in
     ``docs/doppler.md``).
 
-    Blocks: ``az_block`` lines x ``rg_block`` samples (the seed's 2048 x 128). ``estimator``: a name in
+    Blocks: ``az_block`` lines x ``rg_block`` samples (2048 x 128 as in [Koh2003, §5]). ``estimator``: a name in
     :data:`sarcli.doppler.estimators.ESTIMATORS` (built in: cde, sde, rc-cde, lb). ``gain_steps``:
     receiver-gain steps recovered from the echo and undone: auto (quantized products without an AGC
     record) | on | off. ``lb_band_fraction``: look-balance processed band, fraction of the PRF.
@@ -35,10 +35,10 @@ class DopplerOptions:
     Blocks used: valid when their quality exceeds ``noise_sigmas`` standard deviations of the white-noise
     floor and ``min_quality``; fits flag blocks beyond ``outlier_sigma`` robust standard deviations.
 
-    Models: ``fdc_model`` vector | closed (seed eq. 6); ``fit_degree`` (range, azimuth) of the block fit
+    Models: ``fdc_model`` vector | closed ([Koh2003, eq. 6]); ``fit_degree`` (range, azimuth) of the block fit
     without an orbit, ``resid_degree`` of the data-minus-orbit residual, ``model_degree`` of the dense
     model-grid fit; ``n_nodes`` Hermite nodes (None: the orbit's), ``exact_attitude`` (False: the
-    seed's small-angle rotation).
+    small-angle rotation of [Koh2003, eq. 1]).
 
     Rate: ``fr_method`` auto (orbit if present, else map-drift when the swath is longer than the pulse,
     else the nominal velocity) | orbit | seed | mapdrift; ``velocity_guess_mps`` starts map-drift (and is

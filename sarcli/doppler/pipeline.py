@@ -4,12 +4,12 @@
     1. baseband           a centroid estimator (``estimators``): baseband centroid per block
     2. unwrap             continuous centroid over the block grid (``ambiguity.unwrap_blocks``)
     3. ambiguity          one PRF ambiguity for the scene: orbit + attitude model (vector form or the
-                          seed's closed form eq. 6) with its margin, the half-integer case declared and,
+                          closed form [Koh2003, eq. 6]) with its margin, the half-integer case declared and,
                           when possible, broken by the data-only estimate; without a usable orbit MLCC +
                           MLBF (``dataonly``) with their confidence; "none" keeps the baseband centroid
     4. fit                absolute centroid model fdc(range, time) (``polyfit``)
     5. rate               Doppler rate: exactly -(2/lam) d2R/deta2 at the target of the fitted centroid
-                          (orbit), the seed's route (look angle re-solved from fdc), or, without an orbit,
+                          (orbit), the route of [Koh2003, §4] (look angle re-solved from fdc), or, without an orbit,
                           map-drift autofocus (``mapdrift``) with one effective velocity for the swath
     assemble              :class:`PolyDoppler` with the block table and the :class:`DopplerSummary`
 
@@ -316,7 +316,7 @@ def doppler_rate(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, f
     if method in ("orbit", "seed") and geo is None:
         raise ConfigError(f"fr method {method!r} needs ECI/ECEF state vectors; use --fr-method mapdrift")
     seed_vs_exact = seed_failures = grid_rel = mapdrift_fit = nominal_v = None
-    if geo is not None:  # the seed route next to the exact one, for comparison
+    if geo is not None:  # the seed route ([Koh2003, §4]) next to the exact one, for comparison
         hb = geo.block_height_m
         fr_seed, look_seed, rho_seed = geo.orbit.fr_seed(fdc_fit, Rg, T, hb)
         fr_exact = geo.orbit.fr_exact(Rg, T, fdc_fit, hb)
@@ -328,7 +328,7 @@ def doppler_rate(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, f
         gf = geo.orbit.fr_exact(GR, GT, fit.fdc_poly(GR, GT), hg) if method == "orbit" else \
             geo.orbit.fr_seed(fit.fdc_poly(GR, GT), GR, GT, hg)[0]
         if not np.all(np.isfinite(gf)):
-            raise ConfigError("the seed's look-angle inversion left its asin/sqrt domain inside the scene; "
+            raise ConfigError("the look-angle inversion of [Koh2003, §4] left its asin/sqrt domain inside the scene; "
                               "use --fr-method orbit")
         fr_poly, _ = fit_poly2d(GR, GT, gf, np.ones_like(gf), options.model_degree, k_sigma=np.inf)
         grid_rel = float(np.max(np.abs(fr_poly(GR, GT) / gf - 1.0)))

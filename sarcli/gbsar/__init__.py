@@ -1,4 +1,4 @@
-"""Ground-based SAR (seeds 000 and 003): scene simulation, focusing (DF, RD, BP), interferometry.
+"""Ground-based SAR ([LeeGBSAR-II-2007], [LeeGBSAR-I-2007]): scene simulation, focusing (DF, RD, BP), interferometry.
 
 Local frame of a GB-SAR scene (SI units, right-handed): ``x`` along the rail (increasing rail
 position), ``y`` horizontal away from the rail towards the look side, ``z`` up; the rail centre

@@ -6,10 +6,10 @@ the baseband range profiles P_i of :mod:`sarcli.gbsar.rangecomp` (``P_i(R) = a e
 
     g(x, R0) = exp(-j 4 pi R0/lam) * sum_i w_i P_i(R_i) exp(+j 4 pi R_i/lam) / sum_i w_i
 
-over the stops of the pixel's synthetic aperture (rail within the beam footprint, seed 000 Fig. 2),
+over the stops of the pixel's synthetic aperture (rail within the beam footprint, [LeeGBSAR-II-2007, Fig. 2]),
 ``w_i`` the azimuth taper over that aperture, so a scatterer focuses to its (pattern-weighted)
 reflectivity (times its aperture fraction at the rail ends) with the phase
-``-4 pi R0/lam`` of seed 000's RD image (eq. 21) at every range: no approximation but the linear
+``-4 pi R0/lam`` of the RD image of [LeeGBSAR-II-2007, eq. 21] at every range: no approximation but the linear
 interpolation of the (oversampled) profile and the centre wavelength in the carrier term, which is
 exact because the profile is referenced to f_c. The kernel evaluates ``exp(+j 4 pi (R_i - R0)/lam)``
 in float32 (``R_i - R0`` stays below ~5 m, so the phase error is < 1e-4 rad) and accumulates in
@@ -36,7 +36,7 @@ def bp_kernel(prof, dr, xs, dz, valid, px, pr, kc, half_beam, table, out):
     """Backproject ``prof`` (n_stops, n_r) complex64 (ranges n*dr) onto pixels (px, pr) -> out (n_p,).
 
     Each pixel integrates the stops of its synthetic aperture ``[a, b]`` = rail ``[xs[0], xs[-1]]``
-    intersected with the beam footprint ``|x - px| <= half_beam * pr`` (seed 000 eq. 22-40), weighted by
+    intersected with the beam footprint ``|x - px| <= half_beam * pr`` ([LeeGBSAR-II-2007, eq. 22-40]), weighted by
     the taper ``table`` (sampled on [0, 1]) over [a, b], normalized by the sum of the weights used and
     scaled by ``(b - a) / min(X, 2 half_beam R0)``: a pixel whose aperture is cut by a rail end
     (regions III/IV) is attenuated by its aperture fraction, as in DF and RD, instead of amplifying

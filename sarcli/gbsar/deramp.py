@@ -1,4 +1,4 @@
-"""Deramp-FFT (DF) focusing of seed 000 (eq. 4-12) and its geometric correction.
+"""Deramp-FFT (DF) focusing of [LeeGBSAR-II-2007, eq. 4-12] and its geometric correction.
 
 Expanding ``R(x) = sqrt(R0^2 + (x - xc)^2)`` about the rail centre (x measured from it) gives
 ``R ~ Rc - (xc/Rc) x + (R0^2/(2 Rc^3)) x^2`` (the printed eq. 6-7 mix R0 and Rc). DF multiplies the

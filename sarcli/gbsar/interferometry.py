@@ -1,11 +1,11 @@
-"""GB-SAR interferometry of seed 003 (eq. 5-14): DInSAR, cross-track, delta-f and combined modes.
+"""GB-SAR interferometry of [LeeGBSAR-I-2007, eq. 5-14]: DInSAR, cross-track, delta-f and combined modes.
 
 Both images carry the phase ``-4 pi f_c R0/c`` of a scatterer at distance R0 from their own rail
 line. The interferogram is ``z = B * conj(A)`` (secondary times conjugate reference, ``phi = phi_B - phi_A``).
 For a surface point P at height h, horizontal distance y from the rail:
 
 * DInSAR (same geometry, P moved by r along the line of sight): ``phi = -(4 pi/lam) r``
-  -> -12729 deg per metre (1 mm -> -12.7 deg). Seed 003 prints ``phi = (4 pi/lam) r`` with the
+  -> -12729 deg per metre (1 mm -> -12.7 deg). [LeeGBSAR-I-2007, §3.2] prints ``phi = (4 pi/lam) r`` with the
   negative rate; the sign here follows the phase convention.
 * Cross-track (B's rail higher by Bv): ``R_B^2 = y^2 + (H_B - h)^2`` so
   ``phi = -(4 pi/lam)(R_B - R_A) ~ -(4 pi/lam) Bv (H - h)/R``; at fixed pixel range R,
@@ -100,7 +100,7 @@ def support(img: GbsarImage, pol: str, rows: slice = slice(None), values: np.nda
     Covered by its algorithm (``algorithm_map != 0``), non-zero, and -- when the product records the
     footprint's L_x (``report["footprint_antenna_length_m"]``) -- seen by some rail stop: the pixel's
     synthetic aperture, the rail ``[x_c - X/2, x_c + X/2]`` intersected with the beam footprint
-    ``|x - x_i| <= lam R0/(2 L_x)`` (seed 000 Fig. 2, as in BP and DF), is not empty. RD leaks energy
+    ``|x - x_i| <= lam R0/(2 L_x)`` ([LeeGBSAR-II-2007, Fig. 2], as in BP and DF), is not empty. RD leaks energy
     outside the footprint (non-zero there), so the geometric test is needed beside the zero test.
     ``values``: the block ``image[pol, rows]`` when the caller has read it already (it is read otherwise).
     """

@@ -1,4 +1,4 @@
-"""Polarimetric normalized difference of seed 003: separates trees, wet grass and buildings."""
+"""Polarimetric normalized difference of [LeeGBSAR-I-2007, §3.1]: separates trees, wet grass and buildings."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from sarcli.errors import SarcliError
 
 
 def normalized_difference(hh: np.ndarray, vv: np.ndarray, window: int = 1) -> np.ndarray:
-    """Polarimetric normalized difference ``(|HH|^2 - |VV|^2) / (|HH|^2 + |VV|^2)`` in [-1, 1] (seed 003),
+    """Polarimetric normalized difference ``(|HH|^2 - |VV|^2) / (|HH|^2 + |VV|^2)`` in [-1, 1] ([LeeGBSAR-I-2007]),
     powers averaged over a ``window`` x ``window`` boxcar first; NaN where both are zero."""
     from scipy.ndimage import uniform_filter
 

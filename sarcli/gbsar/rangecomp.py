@@ -1,4 +1,4 @@
-"""Range compression of a GB-SAR scan (seed 000 eq. 1-3, Fig. 1): window, zero-pad, inverse FFT.
+"""Range compression of a GB-SAR scan ([LeeGBSAR-II-2007, eq. 1-3, Fig. 1]): window, zero-pad, inverse FFT.
 
 For a sweep ``f_k = f_c + (k - k_c) df`` (k = 0..N_R-1, ``k_c = (N_R-1)/2``) the profile at range r is
 

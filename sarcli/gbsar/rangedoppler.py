@@ -1,4 +1,4 @@
-"""Range-Doppler (RD) focusing of seed 000 (eq. 13-21) with the N_xfft rule of Table 1.
+"""Range-Doppler (RD) focusing of [LeeGBSAR-II-2007, eq. 13-21] with the N_xfft rule of Table 1.
 
 About the target's own azimuth xc the phase history is the azimuth chirp of eq. 18
 (``u_Dc = 0``, ``u_R = -2/(lam R0)``); it is shift-invariant in x at fixed R0, so RD correlates each

@@ -14,7 +14,7 @@ Antenna pattern (``antenna_pattern``): the boresight is horizontal along +y, til
 elevation planes of the antenna. ``pattern = "sinc"``: two-way amplitude
 ``sinc^2(L_x sin(az)/lam) * sinc^2(L_R sin(el)/lam)`` at the centre wavelength (the 11 % frequency
 dependence of the beam over a 600 MHz sweep is neglected). ``pattern = "rect"``: the paper's ideal
-beam (seed 000 eq. 22): 1 inside ``|tan az| <= lam/(2 L_x)`` and ``|tan el| <= lam/(2 L_R)``,
+beam ([LeeGBSAR-II-2007, eq. 22]): 1 inside ``|tan az| <= lam/(2 L_x)`` and ``|tan el| <= lam/(2 L_R)``,
 0 outside; nothing is received from behind the antenna.
 """
 

@@ -1,4 +1,4 @@
-"""Derived GB-SAR system parameters: seed 000 Table 1, the DF range limit (eq. 11-12) and the
+"""Derived GB-SAR system parameters: [LeeGBSAR-II-2007, Table 1], the DF range limit (eq. 11-12) and the
 azimuth resolution of regions I-IV (eq. 22-45).
 
 Notation as in the paper: f_c centre frequency, B_R bandwidth, N_R frequencies, df = B_R/(N_R-1),
@@ -50,7 +50,7 @@ def df_phase_error(wavelength_m: float, r0: np.ndarray, xc: np.ndarray, x: np.nd
 
 @dataclass
 class System:
-    """Table 1 of seed 000 for one configuration (SI units; None where undefined)."""
+    """[LeeGBSAR-II-2007, Table 1] for one configuration (SI units; None where undefined)."""
 
     center_frequency_hz: float
     bandwidth_hz: float
@@ -174,7 +174,7 @@ def synthetic_aperture(r0: float, xc: float, rail_length_m: float, wavelength_m:
 
 def azimuth_resolution(r0: float, xc: float, rail_length_m: float, wavelength_m: float,
                        antenna_length_m: float, algorithm: str = "rd") -> tuple[str, float]:
-    """Region and azimuth resolution (m) of seed 000: ``lam R/(2 L_s)`` with ``L_s`` the aperture length,
+    """Region and azimuth resolution (m) of [LeeGBSAR-II-2007]: ``lam R/(2 L_s)`` with ``L_s`` the aperture length,
     ``R = R0`` for RD/BP (eq. 27, 33, 39, 45) and ``R = Rc`` for DF (eq. 25, 31, 37, 43).
 
     The resolution is the paper's ``1/B`` convention: the width of the sinc response at 2/pi of

@@ -1,7 +1,7 @@
-"""Temporal coherence, persistent-scatterer (PS) selection and PS time series (seed 003).
+"""Temporal coherence, persistent-scatterer (PS) selection and PS time series ([LeeGBSAR-I-2007, §3.6]).
 
 For N co-registered images ``z_i`` of the same geometry the temporal coherence of a pixel is
-``gamma = |sum_i z_i| / sum_i |z_i|`` (0..1): 1 when the phase never changes. Seed 003 observed
+``gamma = |sum_i z_i| / sum_i |z_i|`` (0..1): 1 when the phase never changes. [LeeGBSAR-I-2007, §3.6] observed
 gamma > 0.9 -> phase changes < 10 deg and gamma > 0.99 -> < 1 deg. PS are pixels with gamma at or
 above a threshold and an amplitude within ``dynamic_range_db`` of the brightest pixel. Their phase
 relative to the first image, unwrapped along time, converts to LOS displacement

@@ -1,6 +1,6 @@
 """Spatial phase unwrapping of GB-SAR interferograms with SNAPHU (the ``snaphu`` Python package).
 
-Why SNAPHU [Chen2001]: it is the unwrapper of the InSAR processors (ISCE, GAMMA's MCF is its cousin), a
+Why SNAPHU [ChenZebker2001]: it is the unwrapper of the InSAR processors (ISCE, GAMMA's MCF is its cousin), a
 statistical-cost network flow whose costs come from the coherence, so it routes the unavoidable 2 pi
 discontinuities through the decorrelated pixels instead of across the coherent ones; it reports
 connected components (regions unwrapped consistently with each other). scikit-image's

@@ -125,7 +125,7 @@ class MapDriftFit:
 
 @dataclass(frozen=True)
 class RateDiagnostics:
-    """How the Doppler rate was obtained: the seed route against the exact one (with an orbit), the
+    """How the Doppler rate was obtained: the seed route ([Koh2003, §4]) against the exact one (with an orbit), the
     map-drift fit, or the nominal velocity."""
 
     seed_vs_exact_max_rel: float | None = None
@@ -146,7 +146,7 @@ class RateDiagnostics:
 
 @dataclass(frozen=True)
 class GeometryDiagnostics:
-    """With an orbit: the closed form (seed eq. 6) against the vector model, and the data against the model."""
+    """With an orbit: the closed form ([Koh2003, eq. 6]) against the vector model, and the data against the model."""
 
     closed_minus_vector_max_abs_hz: float | None = None
     fdc_data_minus_orbit_rms_hz: float | None = None

@@ -128,7 +128,7 @@ def _crop(image: np.ndarray, azimuth_time: np.ndarray, slant_range: np.ndarray, 
 def compare(raw: RawProduct, settings: OpticalSettings = OpticalSettings(),
             centre_range_m: float | None = None, single_limitations: bool = True,
             keep_images: bool = False, on_step=None) -> dict[str, Any]:
-    """The comparison report (JSON-ready): design, seed coefficients, predictions, one row per image.
+    """The comparison report (JSON-ready): design, [KimAODCCD] coefficients, predictions, one row per image.
 
     With ``keep_images`` the report also has ``images`` (label -> crop around the brightest target),
     which is not JSON; ``on_step(label)`` is called after each image (progress)."""

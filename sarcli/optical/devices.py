@@ -1,6 +1,6 @@
 """Device parameters of the AOD/CCD processor and the processor design derived from the radar geometry.
 
-Signal chain (seed 004, §2.1-2.3, in this module's notation):
+Signal chain ([KimAODCCD, §2.1-2.3], in this module's notation):
 
 * The echo of pulse n, heterodyned to the AOD centre frequency nu1 and summed with a reference tone at
   nu2 = nu1 + dnu (eq. 6), travels through the AOD at the acoustic speed v_a. A light flash at time t_f
@@ -15,8 +15,8 @@ Signal chain (seed 004, §2.1-2.3, in this module's notation):
   sign that makes the carrier term at 2 theta focus (eq. 13's cos(4 pi u0 x + phi)): the focused image
   sits on a carrier at 2 dnu and is demodulated after read-out.
 
-Seed coefficients reproduced by :func:`seed_mask_coefficients` (AOD plane, magnification 1):
-u0 = dnu / v_a (cycles/m; the seed prints "rad/m" but writes 2 pi u0 x) = 16207 for dnu = 10 MHz
+The coefficients of [KimAODCCD, §2.5(3)-(4)] reproduced by :func:`seed_mask_coefficients` (AOD plane, magnification 1):
+u0 = dnu / v_a (cycles/m; [KimAODCCD] prints "rad/m" but writes 2 pi u0 x) = 16207 for dnu = 10 MHz
 (printed 16210), and b2 = 4 v^2 T^2 v_a f0 / (c^2 dy^2) = 385.56 m^-1 (printed "m^-2"), which equals our
 psi only with a factor pi: psi = pi * b2 * y^2 / x with y = r dy and x = v_a 2R/c. The printed eq. 12
 drops that pi (typo). The AOD coefficient b1 = 7.88e-2 could not be reconciled with any unit choice of
@@ -33,7 +33,7 @@ from sarcli.model.constants import C_LIGHT
 
 @dataclass(frozen=True)
 class AOD:
-    """Acousto-optic device: 45 MHz centre, 30 MHz bandwidth, 31 mm aperture, 0.617 mm/us (seed §3)."""
+    """Acousto-optic device: 45 MHz centre, 30 MHz bandwidth, 31 mm aperture, 0.617 mm/us ([KimAODCCD, §2.5(1)])."""
 
     center_frequency_hz: float = 45.0e6
     bandwidth_hz: float = 30.0e6
@@ -48,7 +48,7 @@ class AOD:
 
 @dataclass(frozen=True)
 class CCD:
-    """Interline-transfer CCD: 384 (H, range) x 491 (V, azimuth) pixels of 23.0 x 13.4 um (seed §3)."""
+    """Interline-transfer CCD: 384 (H, range) x 491 (V, azimuth) pixels of 23.0 x 13.4 um ([KimAODCCD, §2.5(2)])."""
 
     columns: int = 384
     rows: int = 491
@@ -59,7 +59,7 @@ class CCD:
 
 @dataclass(frozen=True)
 class OpticalSettings:
-    """Knobs of the emulated processor. ``reference_offset_hz`` None -> the seed's rule dnu = B.
+    """Knobs of the emulated processor. ``reference_offset_hz`` None -> the rule dnu = B of [KimAODCCD].
 
     ``magnification``: "carrier" (default) images the AOD onto the CCD so that the focused carrier at
     2 dnu is sampled by the pixels (two pixels per period at the band edge); "fit_aod" images the whole
@@ -133,7 +133,7 @@ def design(bandwidth_hz: float, pulse_length_s: float, centre_delay_s: float, se
 
 def seed_mask_coefficients(carrier_frequency_hz: float, velocity_mps: float, prf_hz: float,
                            reference_offset_hz: float, aod: AOD = AOD(), ccd: CCD = CCD()) -> tuple[float, float]:
-    """(u0 cycles/m, b2 1/m) of eq. 12 in the seed's AOD-plane notation (magnification 1).
+    """(u0 cycles/m, b2 1/m) of eq. 12 in the AOD-plane notation of [KimAODCCD] (magnification 1).
 
     u0 = dnu / v_a; b2 = 4 v^2 T^2 v_a f0 / (c^2 dy^2), T = 1/PRF, dy the CCD row pitch, such that
     pi * b2 * y^2 / x equals the azimuth phase 2 pi v^2 t^2 / (lam R) at y = dy t / T, x = v_a 2 R / c.

@@ -22,7 +22,7 @@ LIMITATIONS: dict[str, str] = {
     "aod_bandwidth": "AOD passband around its centre frequency",
     "light_pulse": "finite flash duration (intensity smear v_a * tau_L)",
     "detector_intensity": "square-law detection with reference carrier and bias terms",
-    "mask": "real mask transmittance (1/2)(1 + cos(2 pi u0 x + psi)) of seed eq. 12",
+    "mask": "real mask transmittance (1/2)(1 + cos(2 pi u0 x + psi)) of [KimAODCCD, eq. 12]",
     "ccd_size": "finite CCD rows (azimuth aperture) and columns (swath)",
     "ccd_pixels": "pixel-area integration across range",
     "adc": "n-bit read-out over the full charge range",

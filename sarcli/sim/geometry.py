@@ -13,7 +13,7 @@ Range and Doppler of a target seen from the platform state (r, v, a), d = p - r,
     R' = d.(p' - v)/R,  R'' = (|p' - v|^2 + d.(p'' - a) - R'^2)/R,
     f_dc = -(2/lam) R',  f_R = -(2/lam) R''                     (see notes/orbit-to-doppler-sim-focus)
 
-(The seed's eq. 4-6 write f_dc = -(2/lam) v_rel.L; with our phase convention exp(-j 4 pi R/lam)
+([Koh2003, eq. 4-6] write f_dc = -(2/lam) v_rel.L; with our phase convention exp(-j 4 pi R/lam)
 the sign is +(2/lam) v_rel.L = -(2/lam) R', which is what is used here.)
 """
 

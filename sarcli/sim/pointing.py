@@ -1,8 +1,8 @@
-"""Antenna axes at every pulse, built on ``orbit.pointing`` (seed section 1 flight/control frames).
+"""Antenna axes at every pulse, built on ``orbit.pointing`` (flight/control frames of [Koh2003, §2]).
 
 Zero attitude means a beam PERPENDICULAR TO THE PLATFORM VELOCITY of the simulation frame (the
 inertial velocity for ECI scenes), so that an inertial scene seen at zero attitude has a zero
-Doppler centroid. The seed's flight frame has Zf along the GEODETIC nadir, which is not
+Doppler centroid. The flight frame of [Koh2003, §2.2] has Zf along the GEODETIC nadir, which is not
 perpendicular to v when the orbit has a radial velocity (eccentricity) or where the geodetic and
 geocentric verticals differ (up to 0.19 deg, i.e. several hundred Hz of Doppler at C band).
 We therefore add the reference pitch

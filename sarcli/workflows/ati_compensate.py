@@ -23,7 +23,7 @@ from sarcli.workflows.ati_estimate import check_choices, estimate_movers, failur
 @dataclass(frozen=True)
 class Config:
     """raw: two-channel raw product; output: ATI product with image_before and image_after; method: exact
-    (R - Rs), quadratic (seed eq. 20) or conventional (neglects vy y0 / R0); compare: also measure the
+    (R - Rs), quadratic ([Ryu2017, eq. 20]) or conventional (neglects vy y0 / R0); compare: also measure the
     conventional method; png_dir: write before/after images and azimuth PSF plots here; route, unwrap,
     bin, pfa: as for ``ati_estimate``."""
 

@@ -32,7 +32,7 @@ def check_choices(**values: str) -> None:
 @dataclass(frozen=True)
 class Config:
     """raw: two-channel raw product; output: write an ATI product with the movers table; route: exact
-    (closed-form geometry), nonlinear (full fit of the exact histories) or seed (the paper's chain);
+    (closed-form geometry), nonlinear (full fit of the exact histories) or seed (the chain of [Ryu2017]);
     unwrap: dechirp (model-guided) or itoh; bin: track (per-line peak near the ANV bin) or anv (one bin);
     pfa: false-alarm probability per pixel of each CFAR test."""
 

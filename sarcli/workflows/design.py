@@ -1,4 +1,4 @@
-"""Workflow ``design``: the SAR design calculator (seed 004 relations, ``sarcli.design``) with a verdict
+"""Workflow ``design``: the SAR design calculator (relations of [KimAODCCD, §2.4], ``sarcli.design``) with a verdict
 per constraint, from a design TOML (``[design]`` table), a stripmap or GB-SAR scene TOML, a raw product
 or a GB-SAR scan. A violated constraint is reported, not an error."""
 

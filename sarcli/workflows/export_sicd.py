@@ -1,6 +1,6 @@
 """The ``sicd`` export format: an SLC as NGA SICD 1.4.0 in NITF, written and checked by sarkit.
 
-Geometry (SICD Vol. 1 and 3, NGA.STND.0024 [SICD14]): a sarcli SLC is a zero-Doppler range-Doppler image,
+Geometry (SICD Vol. 1 and 3, [NGA-SICD]): a sarcli SLC is a zero-Doppler range-Doppler image,
 SICD's range-migration ``RMA`` formation with the ``INCA`` image type on a ``RGZERO`` slant-plane grid.
 SICD rows are ranges and columns azimuth lines, so the pixel array is the SLC transposed (a left-looking
 SLC also has its lines reversed: SICD's column axis must make the grid normal point away from the Earth).

@@ -2,7 +2,7 @@
 persistent scatterers and their phase / LOS displacement series (``gbsar_ps`` product, CSV, plot).
 
 Temporal coherence ``|sum_i z_i| / sum_i |z_i|`` and PS selection: :mod:`sarcli.gbsar.timeseries`
-(seed 003). Memory is bounded: the images are never stacked whole. The reduction is a task graph over
+([LeeGBSAR-I-2007, §3.6]). Memory is bounded: the images are never stacked whole. The reduction is a task graph over
 pixel blocks of ``block_rows`` rows (:mod:`sarcli.parallel.gbsar`): each task reads one block of a
 group of images from their HDF5 files and adds them, in time order, to the block's running sums, so
 the result is the same, bit for bit, as on the full stack. The maps kept whole are the coherence and

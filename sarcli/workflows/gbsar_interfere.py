@@ -1,6 +1,6 @@
 """``gbsar_interfere``: two GB-SAR images (or scans) -> interferogram product (+ GeoTIFFs and PNGs).
 
-``B * conj(A)`` with the model phase of ``mode`` removed and converted (seed 003; see
+``B * conj(A)`` with the model phase of ``mode`` removed and converted ([LeeGBSAR-I-2007, §3.2-3.5]; see
 :mod:`sarcli.gbsar.interferometry`): dinsar -> LOS displacement (mm), crosstrack / combined -> height
 (m), deltaf -> range offset (m). A scan is focused with ``auto`` first, the secondary on the
 reference's grid. Pixels outside the common support are NaN; the converted value is also NaN where

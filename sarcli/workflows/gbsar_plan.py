@@ -1,4 +1,4 @@
-"""``gbsar_plan``: the derived system table of a scene TOML or a scan product (seed 000 Table 1), the
+"""``gbsar_plan``: the derived system table of a scene TOML or a scan product ([LeeGBSAR-II-2007, Table 1]), the
 DF minimum range (eq. 12) and the azimuth resolution by region (eq. 22-45). Writes nothing.
 """
 
@@ -82,7 +82,7 @@ def system(config: Config) -> System:
         s = read_scan(config.source)
         if not s.is_rail:
             raise ConfigError(f"{config.source} has 3-D antenna positions or reference ranges: plan derives the "
-                              "straight-rail system table (seed 000 Table 1), which does not apply to it")
+                              "straight-rail system table ([LeeGBSAR-II-2007, Table 1]), which does not apply to it")
         s, _ = ordered(s)
         f, x, lx, max_range = s.frequency, s.rail_position, s.antenna.length_azimuth_m, config.max_range_m
     return build_system(f, x, lx, max_range, crit)

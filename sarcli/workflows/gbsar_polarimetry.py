@@ -1,5 +1,5 @@
 """``gbsar_polarimetry``: an image (or scan) with HH and VV -> the polarimetric normalized difference
-``(|HH|^2 - |VV|^2)/(|HH|^2 + |VV|^2)`` (seed 003) as a UTM GeoTIFF and / or a slant-plane PNG.
+``(|HH|^2 - |VV|^2)/(|HH|^2 + |VV|^2)`` ([LeeGBSAR-I-2007, §3.1]) as a UTM GeoTIFF and / or a slant-plane PNG.
 
 NaN outside the beam footprint (no support in HH or VV).
 """

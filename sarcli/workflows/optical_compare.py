@@ -1,4 +1,4 @@
-"""Workflow ``optical_compare``: the emulated AOD/CCD processor of seed 004 (ideal, each device limitation
+"""Workflow ``optical_compare``: the emulated AOD/CCD processor of [KimAODCCD] (ideal, each device limitation
 alone, all with and without bias removal) against the digital Range-Doppler image of the same simulated
 point-target scene (``sarcli.optical.compare``); optionally the comparison figure."""
 
@@ -21,7 +21,7 @@ def settings(reference_offset_hz: float | None, magnification: str, adc_bits: in
 @dataclass(frozen=True)
 class Config:
     """raw: simulated airborne raw product with truth; plot: write the comparison figure (PNG);
-    reference_offset_hz: dnu = nu2 - nu1 (default the seed's rule dnu = B); magnification: carrier (pixels
+    reference_offset_hz: dnu = nu2 - nu1 (default the rule dnu = B of [KimAODCCD]); magnification: carrier (pixels
     sample the carrier) or fit_aod; adc_bits: read-out converter bits; centre_range_m: slant range at the
     CCD's centre column (default the brightest target's); quick: skip the one-limitation-at-a-time images."""
 

@@ -1,6 +1,6 @@
 """Plain-numpy synthesis of two-channel slow-time signals from the exact (bistatic) range history.
 
-Independent of sarcli.ati: the geometry is written out here from the seed's Fig. 1 (target on the
+Independent of sarcli.ati: the geometry is written out here from [Ryu2017, Fig. 1] (target on the
 ground, platform at height H along +y), one transmitter on the platform, receiver 0 on it, receiver 1
 ``d`` ahead along-track; receiver-1 samples co-registered by d/(2*Vp).
 """

@@ -125,7 +125,7 @@ def test_bad_snr_spec_is_one_line(cli):
 
 @pytest.mark.slow
 def test_paper_scenario_compensation(tmp_path, cli):
-    """Seed 001 at 20 dB: displaced ~-30..-40 m and smeared; after: 0.2 %, one cell, PSF; ~12 m conventional."""
+    """[Ryu2017] at 20 dB: displaced ~-30..-40 m and smeared; after: 0.2 %, one cell, PSF; ~12 m conventional."""
     raw = _raw(tmp_path, PAPER_SCENE)
     out = tmp_path / "comp.h5"
     figs = tmp_path / "figs"

@@ -1,4 +1,4 @@
-"""docs/validation.md is generated from bench/results (issue 14: measured accuracy is not hand-copied)."""
+"""docs/validation.md is generated from bench/results (measured accuracy is not hand-copied)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""sarcli design: the seed-004 worked example, the relations against independent geometry, and the CLI."""
+"""sarcli design: the worked example of [KimAODCCD], the relations against independent geometry, and the CLI."""
 
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ def test_seed_example_flags_its_violation():
     assert "range_unambiguous" in bad
     assert by_prf[3934.0]["ok"] and by_prf[1967.0]["ok"]
     assert not r["ok"]
-    assert any("19.2" in n for n in r["notes"])  # broadside value stated next to the seed's reading
+    assert any("19.2" in n for n in r["notes"])  # broadside value stated next to the reading of [KimAODCCD]
 
 
 def test_broadside_resolution_is_half_the_seeds_reading():

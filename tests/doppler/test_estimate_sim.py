@@ -201,7 +201,7 @@ def test_geometric_models_agree_with_truth_and_each_other(clutter_raw):
     assert np.max(np.abs(g.fdc_closed(r, t) - tf[::64])) < 1.0  # small-angle + w x r approximation
     np.testing.assert_allclose(g.fr_exact(r, t, tf[::64]), tr[::64], rtol=1e-8)
     fr_seed, look, r_seed = g.fr_seed(tf[::64], r, t)
-    assert np.max(np.abs(fr_seed / tr[::64] - 1)) < 5e-4  # seed route: spherical re-solve of the range
+    assert np.max(np.abs(fr_seed / tr[::64] - 1)) < 5e-4  # seed route ([Koh2003, §4]): spherical re-solve of the range
     assert np.all((look > 0) & (look < np.pi / 2))
     # Hermite order knob (acts on the rates): 2 nodes are visibly worse, 4 within 1e-6 (bench table)
     e2 = np.max(np.abs(OrbitGeometry.from_raw(raw, n_nodes=2).fr_exact(r, t, tf[::64]) / tr[::64] - 1))

@@ -1,4 +1,4 @@
-"""What the estimate refuses, and what it says when it cannot decide the ambiguity (issue 13 §3): in-memory
+"""What the estimate refuses, and what it says when it cannot decide the ambiguity (docs/doppler.md): in-memory
 products with broken times or radar parameters (one ProductError line each, never a confident number),
 a narrow swath without an orbit (ambiguity not resolved: in the model, the product, the JSON and one
 warning line), and the input left untouched."""

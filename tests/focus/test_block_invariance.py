@@ -1,4 +1,4 @@
-"""The focused image does not depend on the block size (issue 13 §5).
+"""The focused image does not depend on the block size (docs/focusing.md).
 
 Scene (plain numpy, tests/focus/synth.py): flat hyperbolic geometry, V = 7000 m/s, a centroid of
 -3.4 PRF that moves by 150 Hz along the 3000-line scene (the beam is steered: the exposure, 1400 Hz
@@ -13,7 +13,7 @@ wide, follows fdc(t)); five targets spread over the scene. Two Doppler models:
   (sarcli.focus.rda docstring) -- the block-centre model alone gave up to 0.5 rad between block sizes.
 
 Across block sizes 512 (the shortest block the aperture allows), 2048 and the whole scene, phases
-agree to 0.01 rad and amplitudes to 0.1 % (issue bar) with the consistent model. With the
+agree to 0.01 rad and amplitudes to 0.1 % (the bar of docs/focusing.md) with the consistent model. With the
 estimate-like one the model contradicts the data (by up to 0.04 m/s of V: 0.4 rad at the peak),
 and where that residual lands at the peak depends on the centre of the processed band (its
 tangent's intercept moves by 2 E2 f_c = 2 E0 / f_c, 1.6e-4 rad per Hz), which is the block's
@@ -188,7 +188,7 @@ def test_block_size_on_the_simulated_orbit_scene():
     """The demo scene (samples/rs1_point.toml: rotating Earth, antenna pattern, 4-bit data) with the
     Doppler estimated by sarcli.doppler (its model and the orbit's V vary along azimuth) and the
     orbit-timing correction: before the per-line model, blocks of 1024/2048/4096 lines moved the
-    phases by up to 0.56 rad and the positions by up to 0.05 line (issue 13). Bar: 0.01 rad, 0.1 %;
+    phases by up to 0.56 rad and the positions by up to 0.05 line. Bar: 0.01 rad, 0.1 %;
     the peak phase within 0.05 rad of -4 pi R0 / lam + the target's own phase (90 deg for the third)."""
     from pathlib import Path
 

@@ -1,7 +1,7 @@
 """``sarcli focus`` refuses, in one line and before any work, what would destroy an input or give a
-wrong answer (issue 13 §1, §3): an output that is the input (same path, through GeoTIFF/PNG options
-too, or a hard link), a raw product its reader marked not focusable, a Doppler model whose PRF
-ambiguity is unresolved (unless accepted, or the centroid is given)."""
+wrong answer (docs/focusing.md, "What `sarcli focus` refuses"): an output that is the input (same path,
+through GeoTIFF/PNG options too, or a hard link), a raw product its reader marked not focusable, a Doppler model
+whose PRF ambiguity is unresolved (unless accepted, or the centroid is given)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Processing never reads the simulator's answer (issue 13 §4): a scan of the processing packages'
+"""Processing never reads the simulator's answer (docs/focusing.md): a scan of the processing packages'
 sources for reads of ``truth`` (``x.truth[...]``, ``(x.truth or {}).get``, ``truth[...]``,
 ``truth.get(``) and for the truth's ``reference_height_m``.
 

@@ -1,4 +1,4 @@
-"""Terrain inputs (issue 13 §4): the DEM reader, the geoids, and geocoding on the terrain.
+"""Terrain inputs (docs/focusing.md, "Terrain"): the DEM reader, the geoids, and geocoding on the terrain.
 
 - DEM: a plane z = a + b x + c y in a projected CRS is reproduced exactly by bilinear interpolation
   (query points projected independently with pyproj); a point outside or next to nodata is refused.

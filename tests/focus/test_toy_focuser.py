@@ -1,4 +1,4 @@
-"""A new focuser is one file plus one registration (issue 14; docs/focusing.md "A new focuser").
+"""A new focuser is one file plus one registration (docs/extending.md, "A new focuser").
 
 The toy focuser below scales the raw lines by ``gain`` (no focusing at all: its output is checked
 exactly against the input). Registered with ``FOCUSERS.register``, it runs through

@@ -1,6 +1,6 @@
 """Fuzz harness: corrupt a copy of a real product, run a sarcli command on it, check the promises.
 
-The promises (issue 13, acceptance), checked for every case:
+The promises (docs/products.md, "The fuzz suite"), checked for every case:
 
 - the command exits 0 and its products are plausible (they pass their own reader's validation, every
   number finite), or it exits non-zero with exactly one ``sarcli: error:`` line on stderr;

@@ -1,4 +1,4 @@
-"""Explicit fuzz cases, each a defect the fuzzer once found outside the product readers (issue 13), kept
+"""Explicit fuzz cases, each a defect the fuzzer once found outside the product readers, kept
 as regressions with the file that had it; and the fuzz over the Doppler and SLC products (read by
 focus, quality and info). Same promises as every fuzz test (tests/fuzz/harness.py)."""
 
@@ -53,10 +53,10 @@ KNOWN = [
     ("doppler-truth-height-empty", "raw", DataEdit("/truth/reference_height_m", "empty"), ("doppler", "{IN}", "-o",
                                                                                             "{OUT}"),
      "TypeError: only 0-dimensional arrays can be converted to Python scalars",
-     "sarcli/doppler/api.py estimate_doppler (reads truth, issue 13 §4)"),
+     "sarcli/doppler/api.py estimate_doppler (reads truth)"),
     ("focus-truth-height-complex", "raw", DataEdit("/truth/reference_height_m", "to_complex"),
      ("focus", "{IN}", *FDC_FR, "-o", "{OUT}"), "TypeError: float() argument must be ... not 'complex'",
-     "sarcli/focus/rda.py _reference_height (reads truth, issue 13 §4)"),
+     "sarcli/focus/rda.py _reference_height (reads truth)"),
     ("doppler-poly-attr-array", "doppler", AttrEdit("/fdc_poly", "y0", (1.0, 2.0, 3.0)),
      ("focus", "{raw}", "--doppler", "{IN}", "-o", "{OUT}"),
      "TypeError: only 0-dimensional arrays can be converted", "sarcli/io/doppler_product.py _read_poly"),
@@ -108,7 +108,7 @@ WRITERS = [  # (input, command whose {SELF} output names the input file itself, 
                          ids=[f"{p}-{c[0]}-{i}" for i, (p, c, _) in enumerate(WRITERS)])
 @pytest.mark.parametrize("alias", ["same", "hardlink"])
 def test_output_equal_to_an_input_is_refused(pristine, tmp_path, product, command, member, alias):
-    """Issue 13 §1: an output naming an input (or a hard link to it) is refused before any work (a usage
+    """An output naming an input (or a hard link to it) is refused before any work (a usage
     error, exit 2), the input intact."""
     import hashlib
     import os

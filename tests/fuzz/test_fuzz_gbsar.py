@@ -1,5 +1,5 @@
 """Fuzz the commands that read GB-SAR scans and images: gbsar focus, interfere (scans and images),
-polarimetry, info (issue 13, acceptance; the promises are in tests/fuzz/harness.py)."""
+polarimetry, info (docs/products.md, "The fuzz suite"; the promises are in tests/fuzz/harness.py)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Fuzz the commands that read a raw product: doppler, focus (estimating the Doppler: the echo read in
-memory, and streamed with --fdc/--fr or --doppler), orbit info, info (issue 13, acceptance), damage to
+memory, and streamed with --fdc/--fr or --doppler), orbit info, info (docs/products.md, "The fuzz suite"), damage to
 /truth included (processing never reads it; quality and info check it). Every corrupted input gives
 exit 0 with a plausible product or exactly one error line, never a traceback or a hang, the input bytes
 unchanged, no partial output (tests/fuzz/harness.py).

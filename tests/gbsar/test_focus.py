@@ -54,7 +54,7 @@ def test_range_compression_peak_phase_and_sidelobes():
 
 
 def _indoor_scan():
-    """Seed 000's indoor geometry: point targets at 5 m across the beam, a wall at 6 m, sinc beam."""
+    """The indoor geometry of [LeeGBSAR-II-2007, §3]: point targets at 5 m across the beam, a wall at 6 m, sinc beam."""
     pts = [(x, 5.0) for x in (-1.4, -0.7, 0.0, 0.7, 1.4)]  # whole footprints on the 4 m rail
     wall = [{"start_m": [-3.0, 6.0, 0.0], "end_m": [3.0, 6.0, 0.0], "spacing_m": 0.01, "scattering": 0.05}]
     return scan_of(pts, walls=wall, effects={"antenna_pattern": {}})

@@ -1,4 +1,4 @@
-"""Interferometric phase rates of seed 003 measured from simulated interferograms, PS coherence,
+"""Interferometric phase rates of [LeeGBSAR-I-2007] measured from simulated interferograms, PS coherence,
 polarimetry and the mismatched-scan errors."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from sarcli.gbsar.simulate import simulate
 from sarcli.gbsar.timeseries import ps_series, select_ps, temporal_coherence
 from tests.gbsar.helpers import scene_dict
 
-H = 21.0  # antenna height above the lawn (seed 003)
+H = 21.0  # antenna height above the lawn ([LeeGBSAR-I-2007, §3])
 BP = FocusOptions(algorithm="bp")
 
 
@@ -106,7 +106,7 @@ def test_mismatched_scans_are_clear_errors():
 
 
 def test_ps_coherence_stable_vs_decorrelated():
-    """Nine scans (seed 003's P1-P9): stable points gamma > 0.99, phase change < 1 deg; clutter drops."""
+    """Nine scans ([LeeGBSAR-I-2007] P1-P9): stable points gamma > 0.99, phase change < 1 deg; clutter drops."""
     stable = [_ground(x, 40.0) for x in (-6.0, 0.0, 6.0)]
     clutter = {"x_m": [-8.0, 8.0], "y_m": [45.0, 55.0], "density_per_m2": 2.0, "scattering": 0.3, "seed": 5}
     grid = Grid(ranges=np.array([40.0] + list(np.arange(49.0, 55.0, 0.6))), azimuths=np.arange(-7.5, 7.6, 0.5))
@@ -128,7 +128,7 @@ def test_ps_coherence_stable_vs_decorrelated():
 
 
 def test_temporal_coherence_theory():
-    """gamma = |sum z| / sum |z| (seed 003): unequal amplitudes tell it apart from |sum z| / N."""
+    """gamma = |sum z| / sum |z| ([LeeGBSAR-I-2007, §3.6]): unequal amplitudes tell it apart from |sum z| / N."""
     amp, ph = np.array([1.0, 3.0, 0.5, 2.0]), np.array([0.0, 0.1, -0.1, 0.05])
     z = (amp * np.exp(1j * ph))[:, None]
     assert temporal_coherence(z)[0] == pytest.approx(abs(np.sum(amp * np.exp(1j * ph))) / amp.sum())
@@ -198,7 +198,7 @@ def test_signed_zeros_outside_support_are_nan_not_pi():
 
 def test_pixels_outside_the_beam_footprint_are_nan_for_every_algorithm():
     """BP images 0 outside the footprint, RD leaks energy there: both masked by the footprint geometry
-    |x| - X/2 > lam R0/(2 L_x) (seed 000 Fig. 2); a bright target inside keeps its height."""
+    |x| - X/2 > lam R0/(2 L_x) ([LeeGBSAR-II-2007, Fig. 2]); a bright target inside keeps its height."""
     lx, lam = 0.25, 299792458.0 / 5.3e9
     ant = {"length_azimuth_m": lx, "pattern": "sinc"}
     pts = [_ground(0.0, 50.0, 2.0), _ground(-4.0, 50.0)]

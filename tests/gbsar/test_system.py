@@ -1,4 +1,4 @@
-"""Seed 000 Table 1 from `sarcli gbsar plan`, the DF limit (eq. 11-12) and the region formulas."""
+"""[LeeGBSAR-II-2007, Table 1] from `sarcli gbsar plan`, the DF limit (eq. 11-12) and the region formulas."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from sarcli.gbsar.system import azimuth_resolution, build_system, df_min_range, 
 from sarcli.model.constants import C_LIGHT
 from tests.conftest import SAMPLES
 
-# Table 1 of seed 000 (indoor, outdoor); the paper uses c = 3e8, hence rel tolerances of 0.2-0.5 %
+# [LeeGBSAR-II-2007, Table 1] (indoor, outdoor); the paper uses c = 3e8, hence rel tolerances of 0.2-0.5 %
 TABLE1 = {
     "gbsar_indoor.toml": {"range_resolution_m": 0.25, "r_max_m": 25.0, "range_pixel_m": 0.195, "n_rfft": 256,
                           "n_x": 81, "n_xfft_df": 128, "n_xfft_rd": 256, "frequency_step_hz": 3e6,
@@ -73,7 +73,7 @@ def test_region_formulas_match_eq_27_33_39_45():
     assert reg == "IV" and d == pytest.approx(1 / (2 / (lam * 10) * (x / 2 - 2.0) + 1 / lx))
     reg, d = azimuth_resolution(100.0, 5.0, x, lam, lx, "df")
     assert d == pytest.approx(lam * np.hypot(100, 5) / (2 * x))
-    # seed 003 quotes 0.5 m at 100 m and 3.4 m at 600 m. Its own formula lam R/(2X) gives 0.566 m at
+    # [LeeGBSAR-I-2007, §3.1] quotes 0.5 m at 100 m and 3.4 m at 600 m. Its own formula lam R/(2X) gives 0.566 m at
     # 100 m (lam = 0.0566 m, X = 5 m): the printed 0.5 m is rounded down, not reproduced; 3.4 m is.
     assert azimuth_resolution(100.0, 0.0, x, lam, lx)[1] == pytest.approx(lam * 100.0 / (2 * x), rel=1e-9)
     assert azimuth_resolution(100.0, 0.0, x, lam, lx)[1] == pytest.approx(0.566, abs=0.002)

@@ -10,7 +10,7 @@ import pytest
 from sarcli.io.h5common import atomic_h5, dataset
 from sarcli.io.raw import write_raw
 
-RAW_KEYS = {  # released keys: tests pin them (issue 2 "Machine-readable output" + the spans)
+RAW_KEYS = {  # released keys: tests pin them (the "Machine-readable output" of `sarcli info --json`, plus the spans)
     "product_type", "shape", "prf_hz", "range_sampling_rate_hz", "wavelength_m", "first_range_m",
     "azimuth_start_utc", "n_state_vectors", "orbit_frame", "schema_version", "file", "source",
     "epoch_utc", "provenance", "attributes", "datasets", "main_dataset", "n_lines", "n_samples",

@@ -1,4 +1,4 @@
-"""``sarcli info`` beyond products (issue 18): a GeoTIFF (size, CRS, bounds, nodata, band units and tags),
+"""``sarcli info`` beyond products (docs/ingest.md): a GeoTIFF (size, CRS, bounds, nodata, band units and tags),
 a CEOS scene folder (read by its reader, nothing written), and one line for anything else."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""What the product readers refuse (issue 13 §2/§3): one ProductError line for each damaged or implausible
-field, the cases found on real corrupted files, and physical plausibility from first principles."""
+"""What the product readers refuse (docs/products.md, "What sarcli refuses"): one ProductError line for each damaged or
+implausible field, the cases found on real corrupted files, and physical plausibility from first principles."""
 
 from __future__ import annotations
 

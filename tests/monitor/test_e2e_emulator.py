@@ -2,8 +2,8 @@
 monitor`` process on the landslide sample, compared with the emulator's truth file; the offline
 rebuild; a campaign killed mid-scan and mid-update, restarted, equal to an uninterrupted one.
 
-Bars (issue 21): cumulative displacement at the watch points within 0.3 mm + 5 % of the truth; stable
-points within 0.3 mm RMS after APS and visibly worse without (ratio >= 3 here); each alarm level of the
+Bars (docs/monitoring.md, "Measured"): cumulative displacement at the watch points within 0.3 mm + 5 % of the truth;
+stable points within 0.3 mm RMS after APS and visibly worse without (ratio >= 3 here); each alarm level of the
 slide raised within one scan of the truth crossing its threshold (truth level: the highest level its
 true velocity or acceleration reaches), never on the stable areas; the inverse-velocity failure time
 within 10 % of the acceleration phase (t_f - t_a) once three quarters of the phase is seen.

@@ -1,4 +1,4 @@
-"""The emulated AOD/CCD processor (seed 004) against theory, the seed's coefficients and the digital RD."""
+"""The emulated AOD/CCD processor ([KimAODCCD]) against theory, its coefficients and the digital RD."""
 
 from __future__ import annotations
 
@@ -46,7 +46,7 @@ def test_seed_mask_coefficients():
 @given(v=st.floats(50, 400), prf=st.floats(500, 20000), f0=st.floats(1e9, 20e9), R=st.floats(1e3, 5e4),
        rows=st.integers(-300, 300))
 def test_mask_phase_is_pi_b2_y2_over_x(v, prf, f0, R, rows):
-    """The seed's mask term, with the factor pi its eq. 12 drops, is our azimuth matched phase."""
+    """The mask term of [KimAODCCD, eq. 12], with the factor pi it drops, is our azimuth matched phase."""
     _, b2 = seed_mask_coefficients(f0, v, prf, 1e6)
     y = rows * CCD().pitch_y_m
     x = AOD().acoustic_velocity_mps * 2 * R / C_LIGHT
@@ -119,7 +119,7 @@ def test_aod_aperture_cuts_chirps_that_do_not_fit(raw):
 
 
 def test_seed_reference_offset_puts_the_detector_self_term_in_band(raw):
-    """dnu = B (the seed's u0) lets detection products reach the image band: the range response widens
+    """dnu = B (the u0 of [KimAODCCD]) lets detection products reach the image band: the range response widens
     and its sidelobes rise; dnu = 2B (offset-reference holography asks dnu >= 1.5 B) brings both back
     to the ideal processor's (a residual product at the band edge, -0.6 B, narrows the IRW by ~7 %)."""
     _, ideal = run(raw, "ccd_size")

@@ -70,7 +70,7 @@ def test_look_that_misses_the_earth_is_a_clear_error(ecef_truth):
 
 
 def test_attitude_look_plane_solve_recovers_the_beam_target(ecef_truth):
-    """Seed's three-equation solve (range, ellipsoid, look plane) vs the direct ray intersection."""
+    """Three-equation solve of [Koh2003, §3.1] (range, ellipsoid, look plane) vs the direct ray intersection."""
     _, r, v, _ = _states(ecef_truth)
     for scale in (0.0, 1.0, 100.0):
         for exact in (True, False):
@@ -94,7 +94,7 @@ def test_target_from_doppler_constraints_and_side(ecef_truth, side):
 
 
 def test_doppler_sign_convention_and_eci_equivalence(polar_truth):
-    """f_D = -(2/lam) dR/dt (phase exp(-j4piR/lam)): check by finite differences, and ECI (seed eq. 4-5)
+    """f_D = -(2/lam) dR/dt (phase exp(-j4piR/lam)): check by finite differences, and ECI ([Koh2003, eq. 4-5])
     with v_rel = v - w x r gives the same Doppler as ECEF.
 
     Error analysis of the central differences of R(t) = |p - r(t)| (r(t) the Hermite interpolant; t0 and
@@ -237,7 +237,7 @@ def test_look_incidence_range_relations(ecef_truth):
 
 def test_spherical_formulas_exact_in_the_equatorial_plane():
     """For an equatorial satellite the cross-track plane cuts the ellipsoid in a circle of radius a(+h):
-    the seed's spherical formulas must then agree with the ellipsoid solve to rounding."""
+    the spherical formulas of [Koh2003, §4] must then agree with the ellipsoid solve to rounding."""
     rs = 7_167_000.0
     r = np.array([rs, 0.0, 0.0])
     v = np.array([0.0, 7450.0, 0.0])  # flying east along the equator; cross-track plane = x-z plane? no:
@@ -258,7 +258,8 @@ def test_spherical_formulas_exact_in_the_equatorial_plane():
 
 @pytest.mark.parametrize("scale", [0.0, 1.0, 100.0])
 def test_doppler_from_attitude_is_the_beam_doppler(polar_truth, scale):
-    """Seed eq. 4-6: fdc = (2/lam) v_rel . L, with L the beam that reaches slant range rho (ECI, v_rel = v - w x r)."""
+    """[Koh2003, eq. 4-6]: fdc = (2/lam) v_rel . L, with L the beam that reaches slant range rho
+    (ECI, v_rel = v - w x r)."""
     sv = polar_truth.sv
     t = np.array([500.0, 2500.0, 4500.0])
     r, v, _ = sv.interpolate(t)

@@ -42,7 +42,7 @@ def test_flight_frame_is_right_handed_orthonormal(ecef_truth):
 def test_nadir_matches_seed_construction_and_hits_the_subsatellite_point(ecef_truth):
     r, v = _states(ecef_truth)
     lat, lon, h = ecef_to_geodetic(r)
-    # seed: s = (rx, ry, rz + dz), dz = rho (tan phi_gd - tan phi_gc), Zf = -s/|s|
+    # [Koh2003, eq. 2]: s = (rx, ry, rz + dz), dz = rho (tan phi_gd - tan phi_gc), Zf = -s/|s|
     rho = np.hypot(r[:, 0], r[:, 1])
     dz = rho * (np.tan(np.radians(lat)) - r[:, 2] / rho)
     s = r + np.stack([0 * dz, 0 * dz, dz], -1)

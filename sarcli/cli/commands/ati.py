@@ -1,4 +1,4 @@
-"""``sarcli ati detect|estimate|compensate|montecarlo``: SAR-ATI ground moving targets (seed 001)."""
+"""``sarcli ati detect|estimate|compensate|montecarlo``: SAR-ATI ground moving targets ([Ryu2017])."""
 
 from __future__ import annotations
 
@@ -11,9 +11,10 @@ from sarcli.cli.common import emit_json, make_typer, print_status, run_workflow
 ati_app = make_typer(help="SAR along-track interferometry: detect, estimate, compensate ground movers.")
 
 _ROUTE = typer.Option("exact", "--route", help="Estimation route: exact (closed-form geometry, default), "
-                                               "nonlinear (full fit of the exact histories), seed (paper's chain).")
+                                               "nonlinear (full fit of the exact histories), seed ([Ryu2017]'s chain).")
 _UNWRAP = typer.Option("dechirp", "--unwrap", help="Phase unwrapping: dechirp (model-guided, robust) or itoh.")
-_BIN = typer.Option("track", "--bin", help="Range bin: track (per-line peak near the ANV bin) or anv (seed: one bin).")
+_BIN = typer.Option("track", "--bin",
+                    help="Range bin: track (per-line peak near the ANV bin) or anv ([Ryu2017]: one bin).")
 _PFA = typer.Option(1e-6, "--pfa", help="False-alarm probability per pixel of each CFAR test (magnitude, phase).")
 _FLAGS = {"raw": "RAW", "png_dir": "--png-dir"}
 
@@ -80,7 +81,7 @@ def estimate_cmd(
 def compensate_cmd(
     raw_path: Path = typer.Argument(..., help="Two-channel raw product (HDF5); detection and estimation run first."),
     output: Path = typer.Option(..., "-o", "--output", help="ATI product with image_before and image_after."),
-    method: str = typer.Option("exact", "--method", help="Compensation: exact (R - Rs), quadratic (seed eq. 20), "
+    method: str = typer.Option("exact", "--method", help="Compensation: exact (R - Rs), quadratic ([Ryu2017, eq. 20]), "
                                                          "conventional (neglects vy*y0/R0)."),
     compare_conventional: bool = typer.Option(True, "--compare/--no-compare",
                                               help="Also measure the conventional method (position error)."),

@@ -1,4 +1,4 @@
-"""``sarcli design``: the SAR design calculator (seed 004 relations) with a verdict per constraint."""
+"""``sarcli design``: the SAR design calculator (relations of [KimAODCCD, §2.4]) with a verdict per constraint."""
 
 from __future__ import annotations
 

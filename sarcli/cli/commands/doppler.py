@@ -40,23 +40,24 @@ def doppler(
                                    help="Receiver-gain steps recovered from the echo and undone: auto (quantized "
                                         "products without AGC records) | on | off."),
     lb_band: float = typer.Option(0.6, "--lb-band", help="Look-balance processed band, fraction of the PRF."),
-    az_block: int = typer.Option(2048, "--az-block", help="Azimuth lines per block (seed: 2048)."),
-    rg_block: int = typer.Option(128, "--rg-block", help="Range samples per block (seed: 128)."),
+    az_block: int = typer.Option(2048, "--az-block", help="Azimuth lines per block ([Koh2003, §5]: 2048)."),
+    rg_block: int = typer.Option(128, "--rg-block", help="Range samples per block ([Koh2003, §5]: 128)."),
     ambiguity: str = typer.Option("auto", "--ambiguity", metavar="[auto|orbit|data|none]",
                                   help="auto | orbit | data (MLCC+MLBF) | none; auto = orbit if present."),
     ambiguity_value: int = typer.Option(None, "--ambiguity-value", help="Force the scene ambiguity number."),
     fr_method: str = typer.Option("auto", "--fr-method", metavar="[auto|orbit|seed|mapdrift]",
-                                  help="auto | orbit (exact d2R/deta2) | seed (look angle re-solved) | mapdrift."),
+                                  help="auto | orbit (exact d2R/deta2) | seed ([Koh2003]: look angle re-solved) "
+                                       "| mapdrift."),
     fdc_model: str = typer.Option("vector", "--fdc-model", metavar="[vector|closed]",
-                                  help="Geometric model: vector | closed (seed eq. 6)."),
+                                  help="Geometric model: vector | closed ([Koh2003, eq. 6])."),
     fit_degree: str = typer.Option("2,1", "--fit-degree", help="Block fit degrees RANGE,AZIMUTH (no orbit)."),
     n_nodes: int = typer.Option(None, "--hermite-nodes", help="Hermite interpolation nodes (default: orbit's)."),
-    small_angle: bool = typer.Option(False, "--small-angle", help="Small-angle attitude rotation (seed)."),
+    small_angle: bool = typer.Option(False, "--small-angle", help="Small-angle attitude rotation ([Koh2003, eq. 1])."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help="No human-readable summary on stderr."),
 ) -> None:
     """Estimate the Doppler centroid (baseband CDE + ambiguity) and the Doppler rate.
 
-    The baseband centroid comes from the echoes (CDE per block, seed 2048 x 128); the PRF ambiguity
+    The baseband centroid comes from the echoes (CDE per block, 2048 x 128 as in [Koh2003, §5]); the PRF ambiguity
     from the orbit + attitude model when the product has state vectors, else from the data (MLCC +
     MLBF, with a confidence); the Doppler rate exactly from the orbit, or by map-drift autofocus.
     An ambiguity nothing could decide is reported (ambiguity_resolved false) with a warning.

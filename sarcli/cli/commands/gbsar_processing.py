@@ -103,7 +103,7 @@ def plan_cmd(
     criterion_deg: float = typer.Option(45.0, "--criterion-deg", help="DF phase-error criterion (deg), eq. 12."),
     json_out: bool = typer.Option(False, "--json", help="Print the table as JSON on stdout."),
 ) -> None:
-    """Print the derived system table (seed 000 Table 1), the DF minimum range and resolution by region.
+    """Print the derived system table ([LeeGBSAR-II-2007, Table 1]), the DF minimum range and resolution by region.
 
     Examples:
 
@@ -270,7 +270,7 @@ def polarimetry_cmd(
     map_pixel: float = typer.Option(None, "--map-pixel", help="GeoTIFF pixel (m) [default: range pixel]."),
     json_out: bool = typer.Option(False, "--json", help="Print a JSON summary on stdout."),
 ) -> None:
-    """Polarimetric normalized difference (|HH|^2-|VV|^2)/(|HH|^2+|VV|^2) image (seed 003).
+    """Polarimetric normalized difference (|HH|^2-|VV|^2)/(|HH|^2+|VV|^2) image ([LeeGBSAR-I-2007, §3.1, Fig. 4d]).
 
     Examples:
 

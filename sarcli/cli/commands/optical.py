@@ -1,4 +1,4 @@
-"""``sarcli optical``: the emulated AOD/CCD processor of seed 004 against the digital RD image."""
+"""``sarcli optical``: the emulated AOD/CCD processor of [KimAODCCD] against the digital RD image."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def compare_cmd(
     json_out: bool = typer.Option(False, "--json", help="Print the report as JSON."),
     plot: Path | None = typer.Option(None, "--plot", help="Write the comparison figure (PNG)."),
     reference_offset_hz: float | None = typer.Option(
-        None, help="Reference-beam offset dnu = nu2 - nu1 (Hz); default the seed's rule dnu = B."),
+        None, help="Reference-beam offset dnu = nu2 - nu1 (Hz); default the rule dnu = B of [KimAODCCD]."),
     magnification: str = typer.Option("carrier", help="carrier (pixels sample the carrier) or fit_aod."),
     adc_bits: int = typer.Option(8, help="Read-out converter bits (the 'adc' limitation)."),
     centre_range_m: float | None = typer.Option(None, help="Slant range at the CCD's centre column (m)."),

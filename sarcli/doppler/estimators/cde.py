@@ -1,4 +1,4 @@
-"""``cde``: the Correlation Doppler Estimator on the raw echo (Madsen 1989; the seed's default).
+"""``cde``: the Correlation Doppler Estimator on the raw echo ([Madsen1989]; the default of [Koh2003, §3.2]).
 
 Per block of ``az_block`` lines x ``rg_block`` samples the lag-1 azimuth correlation
 C = sum h(m+1, k) conj(h(m, k)) has phase 2 pi fdc / PRF, so fdc_bb = PRF arg(C) / (2 pi)

@@ -108,8 +108,8 @@ HUFFMAN_CODES: tuple[tuple[str, ...], ...] = (
 #: Simple reconstruction parameters [S1-ISP, Table 5.2-1]: the value of the largest MCode, by THIDX
 #: (index), for BAQ 3/4/5 bit (A3, A4, A5) and FDBAQ BRC 0..4 (B0..B4). The table's length fixes the
 #: THIDX range of simple reconstruction (THIDX <= len - 1), as in the reconstruction laws of §4.3/§4.4.
-#: Note: example 3 of §4.4 quotes B3(THIDX=5) = 9.48; the table of issue 13 (which the change record
-#: says was modified in issue 12) gives 9.50, used here.
+#: Note: example 3 of §4.4 quotes B3(THIDX=5) = 9.48; the table of document issue 13 (which the change
+#: record says was modified in document issue 12) gives 9.50, used here.
 SIMPLE_A = {
     3: (3.00, 3.00, 3.12, 3.55),
     4: (7.00, 7.00, 7.00, 7.17, 7.40, 7.76),
