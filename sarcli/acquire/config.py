@@ -191,7 +191,7 @@ def estimate(cfg: ScanConfig, remaining: int | None = None) -> PlanEstimate:
     n_pol = len(cfg.polarization.polarizations)
     sweep = vna.estimated_sweep_time(v.points, v.if_bandwidth_hz)
     bytes_per_point = 50 if v.data_format == "FORM4" else 2 * (4 if v.data_format == "FORM2" else 8)
-    transfer = v.points * bytes_per_point / 50e3  # ~50 kB/s through GPIB + USB [U]
+    transfer = v.points * bytes_per_point / 50e3  # ~50 kB/s through GPIB + USB (uncertain, to verify on hardware)
     step_move = move_time(r.step_m * 1000.0, r.feed_mm_min / 60.0, r.accel_mm_s2)
     per_stop = n_pol * (sweep + transfer + (cfg.polarization.settle_s if n_pol > 1 else 0.0)) + step_move + r.settle_s
     end = r.start_m + r.step_m * (r.count - 1)
