@@ -74,7 +74,8 @@ class GrblPinSwitch:
 
 
 class Switch11713A:
-    """An 11713A at GPIB ``address`` (factory 28 (uncertain, to verify on hardware)) on the VNA's Prologix; S9 = TX, S0 = RX."""
+    """An 11713A at GPIB ``address`` (factory 28: uncertain, to verify on hardware) on the VNA's Prologix;
+    S9 = TX, S0 = RX."""
 
     kind = "11713a"
 

@@ -29,7 +29,8 @@ ALLOWED_IFBW_HZ = (10, 30, 100, 300, 1000, 3000, 3700, 6000)
 MIN_FREQUENCY_HZ = 30e3
 MAX_FREQUENCY_HZ = 3e9
 MAX_FREQUENCY_OPT006_HZ = 6e9
-POWER_RANGE_DBM = (-85.0, 10.0)  # depends on range/options (uncertain, to verify on hardware); the readback check catches the rest
+#: depends on the attenuator range and options (uncertain, to verify on hardware); the readback check catches the rest
+POWER_RANGE_DBM = (-85.0, 10.0)
 PARAMETERS = ("S11", "S21", "S12", "S22")
 BINARY_FORMATS = {"FORM2": ">f4", "FORM3": ">f8"}
 DATA_FORMATS = ("FORM4", *BINARY_FORMATS)
