@@ -161,3 +161,24 @@ def test_fuzzed_rslc_reads_or_fails_in_one_line(sim_rslc, tmp_path, data):
         assert str(e) and "\n" not in str(e)
     else:
         assert s.image.ndim == 2
+
+
+def test_a_member_name_that_is_not_utf8_is_no_frequency_group(sim_rslc, tmp_path):
+    """A damaged name (h5py lists it as bytes; the fuzz test above found it) names no member of the
+    layout: the reader skips it and reads the file, or says in one line what is missing."""
+    import shutil
+
+    import h5py
+
+    p = tmp_path / "renamed.h5"
+    shutil.copy(sim_rslc, p)
+    with h5py.File(p, "r+") as f:
+        sw = f["science/LSAR/RSLC/swaths"]
+        sw.create_group(b"frequency\xff")
+    assert read_rslc(p).image.ndim == 2
+    with h5py.File(p, "r+") as f:
+        sw = f["science/LSAR/RSLC/swaths"]
+        sw.move("frequencyA", b"frequencyA\xff")
+    with pytest.raises(SarcliError) as e:
+        read_rslc(p)
+    assert "\n" not in str(e.value)

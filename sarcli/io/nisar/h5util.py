@@ -122,6 +122,12 @@ def number(group: h5py.Group, name: str, path: str | os.PathLike, positive: bool
     return v
 
 
+def member_names(group: h5py.Group) -> list[str]:
+    """The names of a group's members, sorted; a name that is not UTF-8 (h5py gives it as bytes) names no
+    member of the layout, so it is left out (sorting bytes with str would fail)."""
+    return sorted(n for n in group if isinstance(n, str))
+
+
 def text(obj: h5py.Dataset | bytes | str | np.ndarray) -> str:
     """A string dataset/attribute value (scalar, or the first element of a list), stripped."""
     v = obj[()] if isinstance(obj, h5py.Dataset) else obj

@@ -58,6 +58,7 @@ from sarcli.io.nisar.attitude import model_attitude
 from sarcli.io.nisar.h5util import (
     band_root,
     is_hdf5,
+    member_names,
     need,
     number,
     open_h5,
@@ -183,7 +184,7 @@ def _read_grid(txg: h5py.Group, freq: str, tx: str, path: Path, notes: list[str]
         windows = [np.tile(np.array([0, sr.size], np.int64), (n, 1))]
         notes.append(f"{txg.name}: no validSamplesSubSwath: every sample taken as valid")
     rx = []
-    for rname in sorted(txg):
+    for rname in member_names(txg):
         m = _RX.match(rname)
         if m is None or not isinstance(txg[rname], h5py.Group):
             continue
@@ -431,7 +432,7 @@ def read_l0b(path: str | os.PathLike, frequencies: tuple[str, ...] = (),
         side = _look_side(ident, path)
         grids: list[_Grid] = []
         found_freqs = []
-        for fname in sorted(swaths):
+        for fname in member_names(swaths):
             m = _FREQ.match(fname)
             if m is None or not isinstance(swaths[fname], h5py.Group):
                 continue

@@ -58,6 +58,7 @@ from sarcli.io.nisar.h5util import (
     band_root,
     complex_rows,
     is_hdf5,
+    member_names,
     need,
     number,
     open_h5,
@@ -533,7 +534,7 @@ class RslcContents:
 
 def _frequencies(sw: h5py.Group, ident: h5py.Group | None) -> dict[str, list[str]]:
     out: dict[str, list[str]] = {}
-    for name in sorted(sw):
+    for name in member_names(sw):
         if not (name.startswith("frequency") and len(name) == 10 and isinstance(sw[name], h5py.Group)):
             continue
         fg = sw[name]
