@@ -12,7 +12,7 @@ LOCK_VENV ?= $(VENV)
 LATEST := .venv-latest
 WARM   := $(VENV)/warm-up
 
-.PHONY: install warm-cache demo test test-latest lock bench lint clean
+.PHONY: install warm-cache demo test test-latest lock bench lint typecheck clean
 
 $(STAMP): pyproject.toml $(LOCK)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -79,6 +79,10 @@ bench: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check sarcli orbit tests bench
+
+## typecheck: mypy on the typed public API (the files of [tool.mypy] in pyproject.toml; docs/extending.md)
+typecheck: $(STAMP)
+	$(BIN)/python -m mypy
 
 ## batch: reprocess a folder, raw -> doppler -> slc -> GeoTIFF + quicklook (focus, issue 5):
 ##   make batch IN=dir OUT=dir [-j N]. IN holds raw products (NAME.h5) and CEOS scene folders

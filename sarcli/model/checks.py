@@ -30,7 +30,9 @@ def number(where: str, name: str, value: Any, lo: float | None = None, hi: float
         raise ProductError(f"{where}: {name} must be finite, got {value}")
     if integer and not float(value).is_integer():
         raise ProductError(f"{where}: {name} must be an integer, got {value}")
-    out: float | int = int(value) if integer else float(value)
+    out: float | int = float(value)
+    if integer:  # an Integral exactly (even beyond 2**53); any other Real is integer-valued here
+        out = int(value) if isinstance(value, numbers.Integral) else int(out)
     if (lo is not None and out < lo) or (hi is not None and out > hi):
         lo_s = "-inf" if lo is None else f"{lo:g}"
         hi_s = "inf" if hi is None else f"{hi:g}"

@@ -180,11 +180,11 @@ class Scan:
             ck.number(where, "n_planned", self.n_planned, lo=0, integer=True)
         self.site.validate(where)
         self.antenna.validate(where)
-        for k, v in self.instrument.items():
+        for name, v in self.instrument.items():
             if isinstance(v, str):
-                ck.text(f"{where}: instrument", k, v)
+                ck.text(f"{where}: instrument", name, v)
             elif not isinstance(v, int | float | bool | np.integer | np.floating | np.bool_):
-                raise ProductError(f"{where}: instrument setting {k} must be text or a number")
+                raise ProductError(f"{where}: instrument setting {name} must be text or a number")
         n_ok = int(np.count_nonzero(self.usable_stops()))
         if n_ok < min_usable_stops:
             raise ProductError(f"{where}: {n_ok} usable rail stop(s) (unflagged, finite S21); at least "

@@ -208,7 +208,7 @@ class RawProduct:
 
     @property
     def shape(self) -> tuple[int, int]:
-        return tuple(self.echo.shape)  # type: ignore[return-value]
+        return tuple(self.echo.shape)
 
     def validate(self, where: str = "raw product", n_samples: int | None = None, finite_samples: bool = True) -> None:
         """Refuse (one :class:`ProductError` line) anything a processor could not trust.
@@ -237,7 +237,7 @@ class RawProduct:
         ck.utc(where, "epoch_utc", self.epoch_utc)
         ck.text(where, "look_side", self.look_side, LOOK_SIDES)
         ck.text(where, "source", self.source)
-        step = 1.0 / self.radar.prf_hz
+        step: float | np.ndarray = 1.0 / self.radar.prf_hz
         if self.prf_per_line is not None:
             prf = ck.array(where, "prf_per_line", self.prf_per_line, "f", shape=(n_lines,))
             if np.any((prf < PRF_HZ[0]) | (prf > PRF_HZ[1])):

@@ -88,7 +88,7 @@ def _pngs(folder: Path, pair: Any, res: Any, after: Any, conv: Any) -> list[Path
     # one dB scale for before / after / conventional: white at the brightest pixel of any of them, 40 dB deep,
     # so the focused mover is visibly brighter than its smeared self
     top = max(float(np.max(np.abs(x[rows, cols]))) for x in (pair.z0, after, conv) if x is not None)
-    vmax = 20.0 * np.log10(max(top, np.finfo(np.float32).tiny))
+    vmax = 20.0 * np.log10(max(top, float(np.finfo(np.float32).tiny)))
     kw = {"extent": ext, "xlabel": "slant range (m)", "ylabel": "azimuth y (m)", "vmin": vmax - 40.0, "vmax": vmax,
           "colorbar_label": "amplitude (dB, one scale for every panel)"}
     written = [folder / f"mover{mid}_before.png", folder / f"mover{mid}_after.png"]

@@ -48,7 +48,7 @@ def refuse_overwriting_inputs(inputs: Iterable[str | os.PathLike | None],
     """Refuse, before any work, an output that is one of the inputs: the same real path (symbolic links
     resolved) or the same file under another name (a hard link: same device and inode), or an output
     given twice. ``None`` entries are skipped. One :class:`ConfigError` line naming both."""
-    seen_in = {}
+    seen_in: dict[str | tuple[int, int], str | os.PathLike] = {}
     for p in inputs:
         if p is None:
             continue

@@ -275,7 +275,7 @@ def _write_scene_report(plan: _Plan, outcomes: dict[str, Any]) -> None:
     from sarcli.io.atomic import atomic_path
     from sarcli.io.h5common import to_jsonable
 
-    steps = [{"step": s, "status": "up to date"} for s in plan.up_to_date]
+    steps: list[dict[str, Any]] = [{"step": s, "status": "up to date"} for s in plan.up_to_date]
     for s in plan.steps:
         o = outcomes[f"{plan.scene.name}:{s}"]
         steps.append({"step": s, "status": o.status, "seconds": o.seconds, "worker": o.worker, "error": o.error,

@@ -35,7 +35,7 @@ class ExportFormat(Protocol):
     name: str
     description: str
     suffix: str
-    Options: type
+    Options: type[Any]
 
     def write(self, slc: SLC, output: Path, options: Any, inputs: tuple[Path, ...]) -> dict[str, Any]: ...
 

@@ -28,11 +28,14 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from sarcli.config import to_mapping
 from sarcli.errors import ConfigError, ProductError
 from sarcli.workflows.base import Progress, Provenance, Report, no_progress, refuse_overwriting_inputs, using
+
+if TYPE_CHECKING:
+    from sarcli.model.raw import RawProduct
 
 log = logging.getLogger(__name__)
 
@@ -159,7 +162,7 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
         from sarcli.io.doppler_product import read_doppler
 
         return read_doppler(config.doppler), f"read from {Path(config.doppler).name}"
-    if config.fdc is not None:
+    if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT
         from sarcli.model.doppler import GeometricDoppler
 
@@ -328,7 +331,7 @@ class _Echo:
 
     def __init__(self, path: Path):
         self.path = path
-        self.raw = None
+        self.raw: RawProduct | None = None
 
     def __call__(self):
         if self.raw is None:

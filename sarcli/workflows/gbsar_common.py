@@ -9,7 +9,7 @@ import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,13 +18,16 @@ from sarcli.errors import ConfigError, ProductError
 from sarcli.model.gbsar import GbsarImage
 from sarcli.workflows.base import refuse_overwriting_inputs
 
+if TYPE_CHECKING:
+    from sarcli.io.images import OverviewKind
+
 
 def guard(inputs: Iterable[str | os.PathLike | None], outputs: Iterable[str | os.PathLike | None]) -> None:
     """Before any work: refuse an output that is an input (same path, symbolic or hard link) and an
     output whose folder does not exist (``None`` entries are skipped)."""
-    outputs = [p for p in outputs if p is not None]
-    refuse_overwriting_inputs(inputs, outputs)
-    for p in outputs:
+    given = [p for p in outputs if p is not None]
+    refuse_overwriting_inputs(inputs, given)
+    for p in given:
         folder = Path(p).resolve().parent
         if not folder.is_dir():
             raise ConfigError(f"output folder {folder} does not exist: create it first")
@@ -107,7 +110,7 @@ def gbsar_tags(img: GbsarImage, inputs: Iterable[str | os.PathLike], **extra: An
 
 def map_outputs(raster: np.ndarray, img: GbsarImage, geotiff: Path | None, png: Path | None, title: str, label: str,
                 cmap: str, vmin: float, vmax: float, map_pixel_m: float | None, *, unit: str,
-                overview: str = "mean", inputs: Iterable[str | os.PathLike] = (),
+                overview: OverviewKind = "mean", inputs: Iterable[str | os.PathLike] = (),
                 brightness: np.ndarray | None = None, brightness_label: str = "") -> dict[str, Any]:
     """UTM GeoTIFF (nearest resampling; a COG with ``unit``, ``label`` as the band description, the
     ``overview`` reduction, provenance tags and a QGIS style ``cmap`` from ``vmin`` to ``vmax``) and a
@@ -125,7 +128,8 @@ def map_outputs(raster: np.ndarray, img: GbsarImage, geotiff: Path | None, png: 
                       tags=gbsar_tags(img, inputs), style=Style(1, vmin, vmax, cmap, label))
         out["geotiff"] = {"path": str(geotiff), "crs": crs, **ginfo}
     if png is not None:
-        kw = {"title": title, "extent": slant_extent(img), "xlabel": "azimuth x (m)", "ylabel": "range R0 (m)"}
+        kw: dict[str, Any] = {"title": title, "extent": slant_extent(img), "xlabel": "azimuth x (m)",
+                              "ylabel": "range R0 (m)"}
         if brightness is not None:
             write_phase_picture(png, raster, brightness, brightness_label=brightness_label, **kw)
         else:

@@ -147,7 +147,7 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
         img = image_from_scan(s, opts, pols=config.pols or None)
         rep = img.report
         timings = rep.pop("seconds")  # wall times stay out of the product (reproducible bytes)
-        write_gbsar_image(config.output, img, parameters=parameters(config), inputs=[config.scan])
+        write_gbsar_image(config.output, img, parameters=parameters(config), inputs=(config.scan,))
         rep["seconds"] = timings
         rep.update(image_outputs(img, config))
         if "df_below_limit" in rep:

@@ -99,8 +99,9 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
                           import_files=",".join(p.name for p in config.inputs))
         antenna = Antenna(length_azimuth_m=config.antenna_length_m) if config.antenna_length_m else Antenna()
         scan = to_scan(sw, pol, config.height_m, antenna, config.epoch_utc, instrument)
-        write_scan(config.output, scan, parameters=parameters(config), inputs=list(config.inputs))
+        write_scan(config.output, scan, parameters=parameters(config), inputs=tuple(config.inputs))
         notes = list(sw.notes)
+        flags = () if scan.stop_flags is None else scan.stop_flags  # to_scan sets one flag per sweep
         if track == "rail" and config.antenna_length_m is None:
             notes.append(f"antenna L_x {antenna.length_azimuth_m:g} m assumed for the rail focusers' beam footprint "
                          "(--antenna-length)")
@@ -108,5 +109,5 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
             output=str(config.output), n_files=len(config.inputs), n_sweeps=scan.n_stops,
             n_frequencies=int(sw.frequency.size), frequency_hz=(float(sw.frequency[0]), float(sw.frequency[-1])),
             format=sw.format, used=sw.used, layout=sw.layout.replace("-", " x "), track=track, polarization=pol,
-            polarization_from=origin, flagged_sweeps=[int(i) for i, f in enumerate(scan.stop_flags) if f],
+            polarization_from=origin, flagged_sweeps=[int(i) for i, f in enumerate(flags) if f],
             notes=notes)

@@ -96,10 +96,9 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
                  "rail_height_a_m": a.rail_height_m, "rail_height_b_m": b.rail_height_m,
                  "center_frequency_a_hz": a.center_frequency_hz, "center_frequency_b_hz": b.center_frequency_hz,
                  "epoch_utc": a.epoch_utc}
-        write_interferogram(c.output, ifg, a.range_m, a.azimuth_m, attrs, parameters=parameters(c),
-                            inputs=[c.reference, c.secondary])
-        n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
         inputs = (c.reference, c.secondary)
+        write_interferogram(c.output, ifg, a.range_m, a.azimuth_m, attrs, parameters=parameters(c), inputs=inputs)
+        n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
         outputs = map_outputs(ifg.residual, a, c.geotiff, c.png, f"{c.mode} residual phase ({pol})",
                               "residual interferometric phase, wrapped", "twilight", -np.pi, np.pi, c.map_pixel_m,
                               unit="rad", overview="phase", inputs=inputs, brightness=ifg.coherence,

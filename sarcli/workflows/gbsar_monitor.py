@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from sarcli.acquire.config import load_config, parse_duration
-from sarcli.errors import ConfigError, Interrupted, SarcliError
+from sarcli.errors import ConfigError, Interrupted, ProductError, SarcliError
 from sarcli.io.scan import read_scan
 from sarcli.monitor.campaign import Campaign, read_campaign_json, scan_time
 from sarcli.monitor.config import MonitorConfig, load_monitor_config, parse_monitor_config
@@ -131,7 +131,8 @@ def _status(path: Path) -> str:
     from sarcli.io.h5common import attr_str, open_product
 
     with open_product(path, "gbsar_scan") as f:
-        return attr_str(f, "status", "unknown")
+        status = attr_str(f, "status")
+    return "unknown" if status is None else status
 
 
 def run(config: Config, provenance=None, progress: Progress | None = None,
@@ -224,4 +225,7 @@ def _scan_epoch(path: Path) -> float:
     from sarcli.io.h5common import attr_str, open_product
 
     with open_product(path, "gbsar_scan") as f:
-        return _posix(attr_str(f, "epoch_utc"))
+        epoch = attr_str(f, "epoch_utc")
+    if epoch is None:
+        raise ProductError(f"{path}: malformed product, attribute 'epoch_utc' missing")
+    return _posix(epoch)

@@ -124,12 +124,12 @@ def run(config: Config, provenance=None, progress: Progress | None = None,
         cfg = config.scan_config()
         if config.dry_run:
             return GbsarPlanOnlyReport(plan=plan_summary(cfg))
-        if (config.output is None) == (config.resume is None):
+        target = config.resume if config.resume is not None else config.output
+        if target is None or (config.output is not None and config.resume is not None):
             raise ConfigError("give exactly one of -o OUTPUT (new scan) or --resume SCAN (continue one)")
         if not config.port or not config.rail_port:
             raise ConfigError("--port (VNA) and --rail-port (GRBL) are required unless --dry-run")
         require_pyserial()
-        target = config.resume if config.resume is not None else config.output
         guard([config.config], [config.output])
 
         def on_stop(n: int, total: int) -> None:

@@ -58,7 +58,7 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
                 progress("stops", i + 1, n)
 
         s = simulate(sc, progress=stops)
-        write_scan(config.output, s, parameters=parameters(config), inputs=[config.scene])
+        write_scan(config.output, s, parameters=parameters(config), inputs=(config.scene,))
         sysp = system_from_scene(sc)
         r = np.linalg.norm(sc.scatterers.position - np.array([0.0, 0.0, sc.height_m]), axis=1)
         wrapped = int(np.sum(r > sysp.r_max_m)) if np.isfinite(sysp.r_max_m) else 0
