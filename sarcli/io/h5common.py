@@ -100,15 +100,25 @@ def cf_time_units(epoch_utc: str) -> str:
     return "seconds since " + parse_utc(epoch_utc).strftime("%Y-%m-%dT%H:%M:%S.%f")
 
 
+#: finished hashes by file version (device, inode, size, modification time in ns): one product's
+#: several images (the focus's two GeoTIFFs of one SLC) read a large input once
+_hashed: dict[tuple[int, int, int, int], str] = {}
+
+
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22, stop: threading.Event | None = None) -> str:
     """Hex SHA-256 of a file's bytes (``stop`` set: abandoned, returns "")."""
+    st = os.stat(path)
+    key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    if key in _hashed:
+        return _hashed[key]
     h = hashlib.sha256()
     with open(path, "rb") as f:
         while block := f.read(chunk):
             if stop is not None and stop.is_set():
                 return ""
             h.update(block)
-    return h.hexdigest()
+    _hashed[key] = h.hexdigest()
+    return _hashed[key]
 
 
 def describe_inputs(paths: Sequence[str | os.PathLike], stop: threading.Event | None = None) -> list[dict[str, str]]:
