@@ -40,6 +40,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sarcli import threads
 from sarcli.errors import ProductError
 from sarcli.io.atomic import atomic_path  # re-exported: plots and CSV writers import it from here
 
@@ -318,9 +319,10 @@ def write_geotiff(
         rasterio.shutil.copy(base, vrt, driver="VRT")
         _attach_overviews(vrt, levels, len(bands))
         with atomic_path(path, ".tif") as tmp:
+            # tiles are deflated on the thread budget's threads, each on its own: the same bytes as one thread
             rasterio.shutil.copy(str(vrt), tmp, driver="COG", COMPRESS="DEFLATE", PREDICTOR="YES",
                                  BLOCKSIZE=str(BLOCK), OVERVIEWS="FORCE_USE_EXISTING" if levels else "NONE",
-                                 BIGTIFF="IF_SAFER")
+                                 BIGTIFF="IF_SAFER", NUM_THREADS=str(threads.budget()))
     if style is not None:
         write_qgis_style(path.with_suffix(".qml"), style, n_bands=len(bands))
 

@@ -179,3 +179,17 @@ def test_gbsar_geotiffs_nan_for_no_signal_and_tagged(cli, tmp_path):
         c = ds.read(1)
     assert np.nanmax(c) <= 1.0 + 1e-6 and np.nanmin(c) >= 0.0
     assert (tmp_path / "coh.png").stat().st_size > 1000 and (tmp_path / "ifg.png").stat().st_size > 1000
+
+
+def test_the_file_does_not_depend_on_the_thread_budget(tmp_path):
+    """The COG's tiles are deflated on the budget's threads, each tile on its own: the same bytes."""
+
+    from sarcli import threads
+
+    a = np.abs(np.random.default_rng(3).standard_normal((700, 600))).astype(np.float32)
+    t = Affine(10.0, 0.0, 500000.0, 0.0, -10.0, 5400000.0)
+    for n in (1, 2):
+        with threads.limited(n):
+            write_geotiff(tmp_path / f"t{n}.tif", [Band(a, "a", "1", "power")], "EPSG:32610", transform=t,
+                          tags={"k": "v"})
+    assert (tmp_path / "t1.tif").read_bytes() == (tmp_path / "t2.tif").read_bytes()
