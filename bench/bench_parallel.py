@@ -13,7 +13,8 @@
    thread started here) vs single-process: wall time, peak RSS of the client and of each worker, and
    the two images compared bit for bit.
 
-Run: ``python -m bench.run_all bench_parallel`` (BENCH_PARALLEL_QUICK=1: section 1 only; ROUNDS env).
+Run: ``python -m bench.run_all bench_parallel`` (BENCH_PARALLEL_QUICK=1: section 1 only;
+BENCH_PARALLEL_ONLY=big: sections 2 and 3 only, section 1 kept from the previous results file; ROUNDS env).
 """
 
 from __future__ import annotations
@@ -168,10 +169,14 @@ def _rasters_equal(a: Path, b: Path) -> bool:
 
 def main() -> None:
     quick = bool(os.environ.get("BENCH_PARALLEL_QUICK"))
+    only_big = os.environ.get("BENCH_PARALLEL_ONLY") == "big"
     data: dict = {"cores": os.cpu_count(), "load_average_start": os.getloadavg()}
     with tempfile.TemporaryDirectory(dir=os.environ.get("BENCH_TMP")) as td:
         tmp = Path(td)
-        data["many"] = bench_many(tmp)
+        if only_big:
+            data["many"] = {**json.loads((RESULTS / "bench_parallel.json").read_text())["many"], "earlier_run": True}
+        else:
+            data["many"] = bench_many(tmp)
         if not quick:
             data["big"] = bench_big(tmp)
     data["load_average_end"] = os.getloadavg()
@@ -180,7 +185,8 @@ def main() -> None:
           f"Machine: {data['cores']} cores, shared (load average {data['load_average_start'][0]:.1f} at the start, "
           f"{data['load_average_end'][0]:.1f} at the end): compare the ratios of this run, not the seconds.", "",
           f"### 1. Eight simulated Radarsat-1 scenes ({m['shape'][0]} x {m['shape'][1]}), sarcli batch, "
-          f"best of {m['rounds']} alternated rounds", ""]
+          f"best of {m['rounds']} alternated rounds"
+          + (" (from an earlier run: this one re-ran sections 2 and 3 only)" if m.get("earlier_run") else ""), ""]
     md.append(markdown_table(
         ["run", "wall s", "speed-up", "efficiency", "scenes / hour / node"],
         [["serial loop (--workers 0, one process, all cores per step)", m["serial_s"], 1.0, 1.0,

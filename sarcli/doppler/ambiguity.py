@@ -90,12 +90,14 @@ def resolve(fdc_bb: np.ndarray, fdc_unwrapped: np.ndarray, fdc_pred: np.ndarray 
 def coverage_factor(dof: float) -> float:
     """t_{0.975, dof} / z_{0.975}: the factor that turns a standard error estimated with ``dof`` degrees of
     freedom into the standard deviation of a Gaussian with the same 95 % interval, so that "within 2
-    sigma" keeps its meaning for an error estimated from a few groups (8 groups: 1.21; inf: 1)."""
-    from scipy import stats
+    sigma" keeps its meaning for an error estimated from a few groups (8 groups: 1.21; inf: 1).
+    The quantiles from scipy.special's inverse CDFs (Student-t ``stdtrit``, normal ``ndtri``: what
+    scipy.stats' ``t.ppf`` and ``norm.ppf`` evaluate, without importing scipy.stats, 0.3 s)."""
+    from scipy.special import ndtri, stdtrit
 
     if not dof > 0:
         return float("inf")
-    return float(stats.t.ppf(0.975, dof) / stats.norm.ppf(0.975))
+    return float(stdtrit(dof, 0.975) / ndtri(0.975))
 
 
 def rounding_confidence(offset: float, sigma: float, dof: float | None = None) -> float:

@@ -16,6 +16,27 @@ too far from the track on the ground (a 1 km hill at Radarsat-1's incidence of a
   range and azimuth spacings of the looks (no aliasing) unless given. Computed and written in row
   strips (the map raster of a full scene is never held whole).
 
+  Map lattice. Locating every map pixel in the triangulation cost 0.2 us a pixel inside the hull and
+  far more outside (scipy searches every triangle when its walk leaves the hull): 34 s for the
+  17751 x 9346 map of a 23000 x 6354 Radarsat-1 scene. So the triangulated map T is evaluated on a
+  lattice of nodes every h map pixels (and the last row and column) and interpolated bilinearly in
+  between (:func:`map_lattice`, kernel :func:`lattice_amplitude`), where that provably stays within
+  ``LATTICE_TOL_PX`` (0.01 pixel) of T. The bilinear interpolant B reproduces affine functions and
+  its weights are >= 0 with sum 1, so |B - T| <= 2 max_cell |T - l| for any affine l; with l the
+  piece of T on a triangle meeting the cell, |B - T| <= 2 d G (d: the cell's diagonal, G: the
+  largest gradient difference between the triangles that meet the cell,
+  :func:`cell_gradient_spread`). A cell inside one triangle thus adds nothing (round-off); where a
+  triangle edge crosses it, G is T's gradient jump there, about the map's second derivative times
+  the triangle size (for the smooth map g itself the familiar bound is (h^2 / 8)(|g_ii| + |g_jj|);
+  T's kinks, not g's curvature, dominate at h << the triangles). Cells that fail the bound, and
+  every cell the hull may cross (its centre within half its diagonal of a hull edge line,
+  :func:`hull_excess`), are evaluated exactly pixel by pixel: NaN outside the image exactly as the
+  triangulation says, and points clearly outside the hull are not searched. h is chosen per map
+  from ``LATTICE_STEPS`` (fewest exact evaluations): 8 for a flat Radarsat-1 swath (97 % of the
+  pixels inside interpolated), smaller where a DEM bends the map on the scale of the coarse grid.
+  Measured against T at every pixel (tests: simulated Radarsat-1 swath, flat and on a 1 km hill):
+  below 1e-3 pixel, the bound 0.01.
+
 Both are Cloud-Optimized GeoTIFFs (:func:`sarcli.io.images.write_geotiff`) with two bands, the amplitude
 (``1``, overviews sqrt(mean |z|^2)) and the amplitude in dB (20 log10, overviews in power), the
 provenance tags of the SLC (sensor, wavelength, look side, first and last zero-Doppler times, the SLC
@@ -27,7 +48,10 @@ map pixel that falls between its rows; the tag ``FULLY_FOCUSED_LINES`` gives the
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit, prange
 
 from sarcli.errors import SarcliError
 from sarcli.model.slc import SLC
@@ -37,6 +61,13 @@ from sarcli.model.terrain import ConstantHeight, Terrain
 STRIP = 512
 #: pixels of the multilooked intensity the dB stretch of the QGIS style is taken from (a regular grid)
 STRETCH_SAMPLES = 1 << 20
+#: map pixels between the nodes where the triangulated inverse map is evaluated: the candidates (module
+#: docstring, :func:`map_lattice`)
+LATTICE_STEPS = (16, 8, 4, 2)
+#: image pixels the lattice may add to the triangulated inverse map's position (module docstring)
+LATTICE_TOL_PX = 0.01
+#: cell classes of :func:`map_lattice`
+OUTSIDE, LATTICE, EXACT = 0, 1, 2
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
@@ -189,8 +220,6 @@ def map_strips(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None =
     map raster is computed strip by strip as it is written, never held whole."""
     from pyproj import Transformer
     from rasterio.transform import Affine
-    from scipy.interpolate import LinearNDInterpolator
-    from scipy.ndimage import map_coordinates
 
     from sarcli.io.images import Strips
 
@@ -222,30 +251,287 @@ def map_strips(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None =
     ny = int(np.ceil((y1 - y0) / spacing_m)) + 1
     if nx * ny > 4e9 / 4:
         raise SarcliError(f"map raster {ny} x {nx} is too large: increase the pixel spacing or the looks")
-    rr, cc = np.meshgrid(rows.astype(float), cols.astype(float), indexing="ij")
-    inv = LinearNDInterpolator(np.column_stack([x.ravel(), y.ravel()]), np.column_stack([rr.ravel(), cc.ravel()]))
+    inverse = MapInverse(x, y, rows, cols)
     full = full_rows(slc, n, looks_az)
-    xs = x0 + np.arange(nx) * spacing_m
+    step, lat_rows, lat_cols, node_r, node_c, cls = map_lattice(inverse, x0, y1, spacing_m, (ny, nx))
+    col_cell = np.minimum(np.arange(nx) // step, cls.shape[1] - 1)
 
     def strips():
         for a in range(0, ny, strip):
             b = min(ny, a + strip)
-            ys = y1 - np.arange(a, b) * spacing_m
-            gx, gy = np.meshgrid(xs, ys)
-            rc = inv(gx.ravel(), gy.ravel())
-            ok = np.all(np.isfinite(rc), axis=1)
-            vals = np.full(gx.size, np.nan, np.float32)
-            if np.any(ok):
-                vals[ok] = map_coordinates(inten, rc[ok].T, order=1, mode="nearest")
-                # a pixel between two rows takes both: masked unless both are fully focused
-                lo = np.clip(np.floor(rc[ok, 0]).astype(np.int64), 0, n - 1)
-                hi = np.clip(np.ceil(rc[ok, 0]).astype(np.int64), 0, n - 1)
-                vals[np.flatnonzero(ok)[~(full[lo] & full[hi])]] = np.nan
-            yield a, np.sqrt(vals).reshape(gx.shape)
+            amp = np.empty((b - a, nx), np.float32)
+            lattice_amplitude(amp, a, step, lat_rows, lat_cols, node_r, node_c, cls, inten, full)
+            i, j = _exact_pixels(cls, col_cell, lat_rows, step, a, b)
+            if i.size:
+                rc = inverse(x0 + j * spacing_m, y1 - i * spacing_m)
+                amp[i - a, j] = points_amplitude(np.ascontiguousarray(rc[:, 0]), np.ascontiguousarray(rc[:, 1]),
+                                                 inten, full)
+            yield a, amp
 
     # pixel (i, j) centre at (x0 + j s, y1 - i s): the raster's corner is half a pixel up-left of it
     transform = Affine(spacing_m, 0.0, x0 - 0.5 * spacing_m, 0.0, -spacing_m, y1 + 0.5 * spacing_m)
     return Strips((ny, nx), strips), transform, crs
+
+
+class MapInverse:
+    """The triangulated inverse map (x, y) -> (row, column) of the multilooked image: linear over the
+    Delaunay triangles of the projected coarse grid (``x``, ``y`` at image ``rows`` x ``cols``), NaN
+    outside their convex hull.
+
+    Locating a point outside the hull costs scipy a search of every triangle (its walk from the last
+    triangle fails), so points beyond the hull by more than ``margin`` (1e-6 of the grid's extent:
+    far beyond qhull's tolerance of 1.5e-7 of a triangle in barycentric coordinates) are NaN at once,
+    from :func:`hull_excess`; the others are scipy's LinearNDInterpolator's values.
+    """
+
+    def __init__(self, x: np.ndarray, y: np.ndarray, rows: np.ndarray, cols: np.ndarray):
+        from scipy.interpolate import LinearNDInterpolator
+        from scipy.spatial import Delaunay
+
+        rr, cc = np.meshgrid(rows.astype(float), cols.astype(float), indexing="ij")
+        tri = Delaunay(np.column_stack([np.ravel(x), np.ravel(y)]))
+        self.interpolator = LinearNDInterpolator(tri, np.column_stack([rr.ravel(), cc.ravel()]))
+        p, e = tri.points, tri.convex_hull
+        d = p[e[:, 1]] - p[e[:, 0]]
+        nrm = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
+        off = np.einsum("ij,ij->i", nrm, p[e[:, 0]])
+        inward = np.einsum("ij,j->i", nrm, p.mean(axis=0)) - off > 0  # the centroid lies inside
+        self.normals = np.ascontiguousarray(np.where(inward[:, None], -nrm, nrm))
+        self.offsets = np.where(inward, -off, off)
+        self.margin = 1e-6 * float(max(np.ptp(p[:, 0]), np.ptp(p[:, 1])))
+
+    def excess(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """:func:`hull_excess` of the points (x, y) (arrays of one shape)."""
+        x, y = np.broadcast_arrays(np.asarray(x, np.float64), np.asarray(y, np.float64))
+        return hull_excess(self.normals, self.offsets, x.ravel(), y.ravel()).reshape(x.shape)
+
+    def __call__(self, x: np.ndarray, y: np.ndarray, excess: np.ndarray | None = None) -> np.ndarray:
+        """(row, col) at the points (x, y) (arrays of one shape), shape + (2,); ``excess``: their
+        :meth:`excess` when the caller has it."""
+        x, y = np.broadcast_arrays(np.asarray(x, np.float64), np.asarray(y, np.float64))
+        near = (self.excess(x, y) if excess is None else excess) <= self.margin
+        out = np.full(x.shape + (2,), np.nan)
+        out[near] = self.interpolator(x[near], y[near])
+        return out
+
+
+@njit(parallel=True, cache=True)
+def hull_excess(normals, offsets, x, y):
+    """max_e (n_e . (x, y) - o_e) over the hull edges e (outward unit normals n_e, offsets o_e): the
+    signed distance beyond the nearest edge line, negative inside the hull (minus the distance to the
+    nearest edge line), positive outside (there a lower bound of the distance to the hull);
+    1-Lipschitz in (x, y). ``x``, ``y``: 1-D."""
+    out = np.empty(x.size)
+    for p in prange(x.size):
+        v = -np.inf
+        for e in range(offsets.size):
+            v = max(v, normals[e, 0] * x[p] + normals[e, 1] * y[p] - offsets[e])
+        out[p] = v
+    return out
+
+
+def hull_excess_numpy(normals: np.ndarray, offsets: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Plain-numpy reference of :func:`hull_excess`."""
+    return np.max(normals[:, 0, None] * x[None, :] + normals[:, 1, None] * y[None, :] - offsets[:, None], axis=0)
+
+
+def _exact_pixels(cls: np.ndarray, col_cell: np.ndarray, lat_rows: np.ndarray, step: int, a: int, b: int):
+    """(rows, columns) of the map pixels in rows [a, b) that lie in ``EXACT`` cells of :func:`map_lattice`
+    (nodes every ``step`` pixels; ``col_cell``: the cell column of each pixel column)."""
+    ii, jj = [], []
+    last = cls.shape[0] - 1
+    for k in range(min(a // step, last), last + 1):
+        lo, hi = max(a, lat_rows[k]), (b if k == last else min(b, lat_rows[k + 1]))
+        if lo >= b:
+            break
+        cols_k = np.flatnonzero(cls[k, col_cell] == EXACT)
+        if cols_k.size and hi > lo:
+            ii.append(np.repeat(np.arange(lo, hi), cols_k.size))
+            jj.append(np.tile(cols_k, hi - lo))
+    if not ii:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return np.concatenate(ii), np.concatenate(jj)
+
+
+def map_lattice(inverse: MapInverse, x0: float, y1: float, spacing: float, shape: tuple[int, int],
+                steps: tuple[int, ...] = LATTICE_STEPS):
+    """The lattice of the map raster (module docstring): (step, lattice rows, lattice columns, image row
+    and image column at the nodes (n_rows_l, n_cols_l), class of each cell (n_rows_l - 1, n_cols_l - 1):
+    ``OUTSIDE`` the hull, ``LATTICE`` (bilinear from its nodes) or ``EXACT``).
+
+    Raster pixel (i, j) of ``shape`` (rows, columns) is at (x0 + j spacing, y1 - i spacing). Nodes
+    every ``step`` pixels and at the last row/column. A cell inside the hull is ``LATTICE`` when the
+    bound 2 d G of :func:`cell_gradient_spread` (d: the cell's diagonal) is within ``LATTICE_TOL_PX``.
+    The step: of ``steps`` (decreasing), the one with the fewest exact evaluations (nodes plus the
+    pixels of ``EXACT`` cells), trying smaller steps while that number decreases and their nodes
+    alone would not cost more.
+    """
+    best = None
+    for step in steps:
+        if best is not None and (shape[0] // step + 1) * (shape[1] // step + 1) >= best[0]:
+            break  # its nodes alone cost more
+        lr, lc, cls = _lattice_classes(inverse, x0, y1, spacing, shape, step)
+        cell_px = np.diff(lr)[:, None] * np.diff(lc)[None, :]
+        cost = lr.size * lc.size + int(np.sum(cell_px[cls == EXACT]))
+        if best is not None and cost >= best[0]:
+            break
+        best = (cost, step, lr, lc, cls)
+    _, step, lr, lc, cls = best
+    node = inverse(x0 + lc[None, :] * spacing, y1 - lr[:, None] * spacing)
+    return (step, lr.astype(np.int64), lc.astype(np.int64), np.ascontiguousarray(node[..., 0]),
+            np.ascontiguousarray(node[..., 1]), cls)
+
+
+def _lattice_classes(inverse: MapInverse, x0: float, y1: float, spacing: float, shape: tuple[int, int], step: int):
+    """(lattice rows, lattice columns, cell classes) of :func:`map_lattice` for one step."""
+    ny, nx = shape
+    lr = np.r_[np.arange(0, max(ny - 1, 1), step), max(ny - 1, 1)]
+    lc = np.r_[np.arange(0, max(nx - 1, 1), step), max(nx - 1, 1)]
+    diag = np.hypot(np.diff(lr)[:, None], np.diff(lc)[None, :])
+    ci, cj = 0.5 * (lr[:-1] + lr[1:]), 0.5 * (lc[:-1] + lc[1:])
+    centre = inverse.excess(x0 + cj[None, :] * spacing, y1 - ci[:, None] * spacing)
+    # wholly inside (outside) the hull: the centre deeper than half the diagonal (hull_excess is 1-Lipschitz)
+    cls = np.full(centre.shape, EXACT, np.int8)
+    cls[centre > 0.5 * diag * spacing + inverse.margin] = OUTSIDE
+    inside = centre < -(0.5 * diag * spacing + inverse.margin)
+    spread = cell_gradient_spread(inverse, x0, y1, spacing, lr, lc)
+    cls[inside & (2.0 * diag * spread <= LATTICE_TOL_PX)] = LATTICE
+    return lr, lc, cls
+
+
+def cell_gradient_spread(inverse: MapInverse, x0: float, y1: float, spacing: float, lat_rows: np.ndarray,
+                         lat_cols: np.ndarray) -> np.ndarray:
+    """Per lattice cell, G: the largest |grad T_a - grad T_b| (image pixels per map pixel, of the row or
+    the column) between the triangles a, b that meet the cell, T_a the affine piece of the
+    triangulated map on triangle a.
+
+    The error bound: B reproduces an affine l, and its weights are >= 0 and sum to 1, so
+    |B - T| <= |B(T - l)| + |T - l| <= 2 max_cell |T - l|; with l = T_a for a triangle a meeting the
+    cell, T - l vanishes at a point q of the cell and grows from there by at most G per map pixel:
+    |B - T| <= 2 d G (d: the cell's diagonal). Zero for a cell inside one triangle; a degenerate
+    (sliver) triangle has an infinite G.
+    """
+    tri = inverse.interpolator.tri
+    pts = np.column_stack([(tri.points[:, 0] - x0) / spacing, (y1 - tri.points[:, 1]) / spacing])  # (j, i)
+    val = inverse.interpolator.values  # (row, col) at the points
+    p, v = pts[tri.simplices], val[tri.simplices]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    d1, d2 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # grad . e1 = d1, grad . e2 = d2 (per output component): Cramer's rule, (n, 2 outputs, 2 coordinates)
+        g = np.stack([(d1 * e2[:, 1, None] - d2 * e1[:, 1, None]) / det[:, None],
+                      (d2 * e1[:, 0, None] - d1 * e2[:, 0, None]) / det[:, None]], axis=2)
+    g = np.where(np.isfinite(g), g, np.inf).reshape(-1, 4)
+    nk, nl = lat_rows.size - 1, lat_cols.size - 1
+    step_r = max(int(lat_rows[1] - lat_rows[0]), 1)
+    step_c = max(int(lat_cols[1] - lat_cols[0]), 1)
+    lo_j, hi_j = np.floor(p[..., 0].min(axis=1)), np.ceil(p[..., 0].max(axis=1))
+    lo_i, hi_i = np.floor(p[..., 1].min(axis=1)), np.ceil(p[..., 1].max(axis=1))
+    k0 = np.clip(lo_i // step_r, 0, nk - 1).astype(int)
+    k1 = np.clip(hi_i // step_r, 0, nk - 1).astype(int)
+    l0 = np.clip(lo_j // step_c, 0, nl - 1).astype(int)
+    l1 = np.clip(hi_j // step_c, 0, nl - 1).astype(int)
+    gmax = np.full((nk, nl, 4), -np.inf)
+    gmin = np.full((nk, nl, 4), np.inf)
+    for t in range(g.shape[0]):
+        box = (slice(k0[t], k1[t] + 1), slice(l0[t], l1[t] + 1))
+        # the cells of the bounding box that the triangle meets: no edge line of the triangle has all four
+        # corners of the cell strictly on its outer side (separating axes of a triangle and a box: the
+        # box's own axes are the bounding box's)
+        ci0, ci1 = lat_rows[k0[t]:k1[t] + 1, None], lat_rows[k0[t] + 1:k1[t] + 2, None]
+        cj0, cj1 = lat_cols[None, l0[t]:l1[t] + 1], lat_cols[None, l0[t] + 1:l1[t] + 2]
+        meets = np.ones((ci0.size, cj0.size), bool)
+        for q in range(3):
+            a, b, c = p[t, q], p[t, (q + 1) % 3], p[t, (q + 2) % 3]
+            nj, ni = b[1] - a[1], a[0] - b[0]  # a normal of edge a-b, pointing away from c
+            if nj * (c[0] - a[0]) + ni * (c[1] - a[1]) > 0:
+                nj, ni = -nj, -ni
+            lowest = (np.minimum(nj * (cj0 - a[0]), nj * (cj1 - a[0]))
+                      + np.minimum(ni * (ci0 - a[1]), ni * (ci1 - a[1])))  # the corner least beyond the edge
+            meets &= ~(lowest > 0)
+        sub_max, sub_min = gmax[box], gmin[box]
+        sub_max[meets] = np.maximum(sub_max[meets], g[t])
+        sub_min[meets] = np.minimum(sub_min[meets], g[t])
+    with np.errstate(invalid="ignore"):
+        rng = np.where(gmax >= gmin, gmax - gmin, 0.0)
+    rng = np.where(np.isnan(rng), np.inf, rng)
+    return np.maximum(np.hypot(rng[..., 0], rng[..., 1]), np.hypot(rng[..., 2], rng[..., 3]))
+
+
+@njit(cache=True, inline="always")
+def _amplitude_at(inten, full, r, c):
+    """sqrt of ``inten`` bilinear at (row r, column c) (edges extended: scipy's map_coordinates
+    order=1, mode="nearest"), NaN where r is not finite or either row around r is not fully
+    focused."""
+    if not (np.isfinite(r) and np.isfinite(c)):
+        return np.float32(np.nan)
+    n, m = inten.shape
+    lo = min(max(int(math.floor(r)), 0), n - 1)
+    hi = min(max(int(math.ceil(r)), 0), n - 1)
+    if not (full[lo] and full[hi]):
+        return np.float32(np.nan)
+    rr = min(max(r, 0.0), n - 1.0)
+    cc = min(max(c, 0.0), m - 1.0)
+    i0 = min(int(rr), n - 1)
+    j0 = min(int(cc), m - 1)
+    i1 = min(i0 + 1, n - 1)
+    j1 = min(j0 + 1, m - 1)
+    fr = rr - i0
+    fc = cc - j0
+    v = ((1.0 - fr) * ((1.0 - fc) * inten[i0, j0] + fc * inten[i0, j1])
+         + fr * ((1.0 - fc) * inten[i1, j0] + fc * inten[i1, j1]))
+    return np.sqrt(np.float32(v))
+
+
+@njit(parallel=True, cache=True)
+def lattice_amplitude(out, first, step, lat_rows, lat_cols, node_r, node_c, cls, inten, full):
+    """Map rows ``first ..`` of the amplitude into ``out`` (rows x nx): at a pixel of a ``LATTICE`` cell
+    of :func:`map_lattice` (nodes every ``step`` pixels) the image position bilinear between the
+    cell's nodes, then :func:`_amplitude_at`; NaN in ``OUTSIDE`` and ``EXACT`` cells (the caller fills
+    the latter). Along a map row the position is linear inside a cell: one addition per pixel."""
+    rows, nx = out.shape
+    nk = cls.shape[0]
+    for q in prange(rows):
+        i = first + q
+        k = min(i // step, nk - 1)
+        wr = (i - lat_rows[k]) / (lat_rows[k + 1] - lat_rows[k])
+        for lc in range(cls.shape[1]):
+            j0 = lat_cols[lc]
+            j1 = lat_cols[lc + 1] if lc < cls.shape[1] - 1 else nx
+            if cls[k, lc] != LATTICE:
+                out[q, j0:j1] = np.nan
+                continue
+            r0 = (1.0 - wr) * node_r[k, lc] + wr * node_r[k + 1, lc]
+            r1 = (1.0 - wr) * node_r[k, lc + 1] + wr * node_r[k + 1, lc + 1]
+            c0 = (1.0 - wr) * node_c[k, lc] + wr * node_c[k + 1, lc]
+            c1 = (1.0 - wr) * node_c[k, lc + 1] + wr * node_c[k + 1, lc + 1]
+            width = lat_cols[lc + 1] - j0
+            for j in range(j0, j1):
+                wc = (j - j0) / width
+                out[q, j] = _amplitude_at(inten, full, r0 + wc * (r1 - r0), c0 + wc * (c1 - c0))
+
+
+@njit(parallel=True, cache=True)
+def points_amplitude(r, c, inten, full):
+    """:func:`_amplitude_at` at the image positions (r, c) (NaN where they are not finite)."""
+    out = np.empty(r.size, np.float32)
+    for p in prange(r.size):
+        out[p] = _amplitude_at(inten, full, r[p], c[p])
+    return out
+
+
+def amplitude_numpy(inten: np.ndarray, full: np.ndarray, r: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Plain-numpy reference of :func:`points_amplitude` (scipy's map_coordinates)."""
+    from scipy.ndimage import map_coordinates
+
+    ok = np.isfinite(r) & np.isfinite(c)
+    vals = np.full(r.shape, np.nan, np.float32)
+    vals[ok] = map_coordinates(inten, np.stack([r[ok], c[ok]]), order=1, mode="nearest")
+    lo = np.clip(np.floor(r[ok]).astype(np.int64), 0, inten.shape[0] - 1)
+    hi = np.clip(np.ceil(r[ok]).astype(np.int64), 0, inten.shape[0] - 1)
+    vals[np.flatnonzero(ok)[~(full[lo] & full[hi])]] = np.nan
+    return np.sqrt(vals)
 
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,

@@ -447,6 +447,12 @@ class _Prober:
         with contextlib.suppress(OSError):
             proc.stdout.close()
 
+    def start(self) -> None:
+        """Start the helper unless it runs (not waiting for it to be ready)."""
+        with self.lock:
+            if self.proc is None or self.proc.poll() is not None:
+                self._start()
+
     def ask(self, path: str, timeout: float) -> str:
         import select
 
@@ -468,6 +474,14 @@ class _Prober:
 
 
 _PROBER = _Prober()
+
+
+def start_probing() -> None:
+    """Start :func:`probe_metadata`'s helper interpreter now without waiting for it: a command that opens
+    products after its own imports overlaps the helper's start-up (an interpreter importing h5py, 0.3 s)
+    with them. A no-op where ``fork`` is not available (no probe there)."""
+    if hasattr(os, "fork"):
+        _PROBER.start()
 
 
 @contextlib.contextmanager

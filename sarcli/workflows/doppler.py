@@ -97,6 +97,9 @@ class DopplerReport(Report):
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> DopplerReport:
     """Estimate the Doppler of ``config.raw`` (``sarcli.doppler.api.estimate_doppler`` over a constant
     terrain height or a DEM), write the product and the plot; ``progress(stage, done, total)``."""
+    from sarcli.io.h5common import start_probing
+
+    start_probing()  # the input's metadata probe starts while the estimators are imported
     from sarcli.doppler.api import estimate_doppler
     from sarcli.io.dem import load_terrain
     from sarcli.io.raw import read_raw

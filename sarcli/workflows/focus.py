@@ -187,6 +187,9 @@ def _refuse_unresolved(model, config: Config) -> None:
 
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> FocusReport:
     """Focus ``config.raw`` into ``config.output`` (and the optional images); see the module docstring."""
+    from sarcli.io.h5common import start_probing
+
+    start_probing()  # the inputs' metadata probe starts while the focusers are imported
     from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, options_for, run_blocks
     from sarcli.io.atomic import all_or_nothing

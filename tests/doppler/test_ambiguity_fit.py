@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from sarcli.doppler.ambiguity import resolve, rounding_confidence, unwrap_blocks
+from sarcli.doppler.ambiguity import coverage_factor, resolve, rounding_confidence, unwrap_blocks
 from sarcli.doppler.cde import wrap_frequency
 from sarcli.doppler.polyfit import fit_poly2d
 
@@ -105,3 +105,15 @@ def test_rounding_confidence_student_t_one_dof_is_the_cauchy_law():
     off, sigma = 3.2, 0.3
     expected = (np.arctan((3.5 - off) / sigma) - np.arctan((2.5 - off) / sigma)) / np.pi
     assert rounding_confidence(off, sigma, dof=1.0) == pytest.approx(expected, rel=1e-12)
+
+
+def test_coverage_factor_closed_forms_and_table():
+    """t_{0.975, nu} / z_{0.975} from the closed-form Student-t quantiles (nu = 1: Cauchy, tan(pi (p - 1/2));
+    nu = 2: (2p - 1) / sqrt(2 p (1 - p))), a published table value (t_{0.975, 7} = 2.3646) and the
+    Gaussian limit; z_{0.975} = 1.959964 (tables)."""
+    p, z = 0.975, 1.959963985
+    assert coverage_factor(1) == pytest.approx(np.tan(np.pi * (p - 0.5)) / z, rel=1e-9)
+    assert coverage_factor(2) == pytest.approx((2 * p - 1) / np.sqrt(2 * p * (1 - p)) / z, rel=1e-9)
+    assert coverage_factor(7) == pytest.approx(2.3646 / z, abs=1e-4)
+    assert coverage_factor(1e9) == pytest.approx(1.0, abs=1e-6)
+    assert coverage_factor(0) == float("inf")

@@ -272,7 +272,7 @@ def test_correct_lines_matches_numpy_and_shifts_a_band_pass_signal():
     carrier = np.full(nr, c)
     ref = correct_lines_numpy(img, 100, 100, 60, lines_c, cols_c, phi, mu, carrier, "sinc16")
     out = np.empty((60, nr), complex)
-    correct_lines(img, 100, 100, out, lines_c, cols_c, phi, mu, carrier, table_for("sinc16")[1])
+    correct_lines(img.copy(), 100, 100, out, lines_c, cols_c, phi, mu, carrier, table_for("sinc16")[1])
     rms = np.sqrt(np.mean(np.abs(img) ** 2))
     assert np.max(np.abs(out - ref)) < 1e-3 * rms  # the kernel's table of 2048 phases vs exact weights
     lines = 100 + np.arange(60)
@@ -290,3 +290,32 @@ def test_correct_lines_matches_numpy_and_shifts_a_band_pass_signal():
                               - 1)) for m in np.linspace(0, mu_max, 11))
     err = np.sqrt(np.mean(np.abs(out - exact * np.exp(1j * px(phi))) ** 2))
     assert err < bound * rms, (err / rms, bound)
+
+
+def test_correct_lines_single_precision_equals_its_complex128_reference_to_round_off():
+    """The complex64 kernel (demodulated in place, real-weighted taps, remodulation advanced line by
+    line) against the complex128 numpy reference with the SAME tabulated weights, on a block like the
+    pipeline's (carrier across the swath around -5.3 cycles per line, shifts up to 0.1 line, a
+    first line not on the block start, taps reaching past the block's ends). Round-off bound: the
+    input (2^-24 relative), its demodulation (one more rounding), 16 complex64 multiply-adds and the
+    output rounding: |error| <= (taps + 3) 2^-24 sum|h| max|s| with sum|h| < 2.1 (the sinc16 table at
+    half-integer shifts)."""
+    from sarcli.focus.interp import table_for
+
+    rng = np.random.default_rng(11)
+    n_in, nr, pad, n_out = 300, 70, 40, 220
+    img = (rng.standard_normal((n_in, nr)) + 1j * rng.standard_normal((n_in, nr))).astype(np.complex64)
+    lines_c = np.r_[np.arange(1000, 1000 + n_out, 16), 1000 + n_out].astype(np.int64)
+    cols_c = np.r_[np.arange(0, nr - 1, 32), nr - 1].astype(np.int64)
+    mu = rng.uniform(-0.1, 0.1, (lines_c.size, cols_c.size))
+    mu[-1] += 40.0  # the last lines read past the block's end (taps skipped there, as in the reference)
+    phi = rng.uniform(-3, 3, mu.shape)
+    carrier = np.linspace(-5.35, -5.25, nr)
+    table = table_for("sinc16")[1].astype(np.float32)
+    out = np.empty((n_out, nr), np.complex64)
+    correct_lines(img.copy(), pad, 1000, out, lines_c, cols_c, phi, mu, carrier, table)
+    ref = correct_lines_numpy(img.astype(np.complex128), pad, 1000, n_out, lines_c, cols_c, phi, mu, carrier,
+                              "sinc16", table=table)
+    assert np.sum(np.abs(table), axis=1).max() < 2.1
+    bound = (16 + 3) * 2.0**-24 * 2.1 * np.max(np.abs(img))
+    assert np.max(np.abs(out - ref)) < bound, (np.max(np.abs(out - ref)), bound)
