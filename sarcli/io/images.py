@@ -150,35 +150,54 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
     return {k: str(v) for k, v in tags.items()}
 
 
-def reduce_block(data: np.ndarray, factor: int, kind: OverviewKind) -> np.ndarray:
-    """One overview level: ``factor`` x ``factor`` cells (partial cells at the edges kept, of size
-    ceil(n / factor) as GDAL's levels), reduced as ``kind`` says (module docstring), NaN ignored."""
+def _summands(data: np.ndarray, kind: OverviewKind) -> tuple[np.ndarray, np.ndarray]:
+    """(the per-pixel terms of the level's mean: a^2, 10^(x/10), exp(j x) or x, 0 where not finite;
+    1 where finite, else 0): cells of every level are sums of these, so one level makes the next."""
     a = np.asarray(data, np.float64)
-    n, m = a.shape
-    nn, mm = -(-n // factor), -(-m // factor)
-    pad = np.full((nn * factor, mm * factor), np.nan)
-    pad[:n, :m] = a
-    cells = pad.reshape(nn, factor, mm, factor)
-    ok = np.isfinite(cells)
-    count = ok.sum(axis=(1, 3))
+    ok = np.isfinite(a)
+    x = np.where(ok, a, 0.0)
     if kind == "power":
-        val = np.where(ok, cells * cells, 0.0).sum(axis=(1, 3))
+        val = x * x
     elif kind == "power_db":
-        val = np.where(ok, 10.0 ** (np.where(ok, cells, 0.0) / 10.0), 0.0).sum(axis=(1, 3))
+        val = np.where(ok, 10.0 ** (x / 10.0), 0.0)
     elif kind == "phase":
-        val = np.where(ok, np.exp(1j * np.where(ok, cells, 0.0)), 0.0).sum(axis=(1, 3))
+        val = np.where(ok, np.exp(1j * x), 0.0)
     elif kind == "mean":
-        val = np.where(ok, cells, 0.0).sum(axis=(1, 3))
+        val = x
     else:
         raise ProductError(f"unknown overview reduction {kind!r}")
-    out = np.full((nn, mm), np.nan)
+    return val, ok.astype(np.float64)
+
+
+def _pool2(x: np.ndarray) -> np.ndarray:
+    """Sums over 2 x 2 cells (an odd last row or column: a partial cell)."""
+    if x.shape[0] % 2 or x.shape[1] % 2:
+        x = np.pad(x, ((0, x.shape[0] % 2), (0, x.shape[1] % 2)))
+    return x[0::2, 0::2] + x[1::2, 0::2] + x[0::2, 1::2] + x[1::2, 1::2]
+
+
+def _level(val: np.ndarray, count: np.ndarray, kind: OverviewKind) -> np.ndarray:
+    """The level's float32 pixels from its cells' sums and counts: NaN where a cell holds no data."""
+    out = np.full(count.shape, np.nan)
     has = count > 0
     if kind == "phase":
         out[has] = np.angle(val[has])
     else:
-        mean = val[has] / count[has]
+        mean = val[has].real / count[has]
         out[has] = np.sqrt(mean) if kind == "power" else (10.0 * np.log10(mean) if kind == "power_db" else mean)
     return out.astype(np.float32)
+
+
+def reduce_block(data: np.ndarray, factor: int, kind: OverviewKind) -> np.ndarray:
+    """One overview level: ``factor`` x ``factor`` cells (``factor`` a power of 2; partial cells at the
+    edges kept, of size ceil(n / factor) as GDAL's levels), reduced as ``kind`` says (module docstring),
+    NaN ignored. The cells' sums and counts are pooled 2 x 2 level after level (exact: sums add)."""
+    if factor < 2 or factor & (factor - 1):
+        raise ProductError(f"overview factor {factor} is not a power of 2")
+    val, count = _summands(data, kind)
+    while factor > 1:
+        val, count, factor = _pool2(val), _pool2(count), factor // 2
+    return _level(val, count, kind)
 
 
 def overview_factors(shape: tuple[int, int], block: int = BLOCK) -> list[int]:
@@ -209,23 +228,34 @@ def _band_strips(bands: Sequence[Band], shape: tuple[int, int]) -> Iterator[tupl
         row += rows
 
 
-def _write_overview(base: str, path: str, factor: int, kinds: Sequence[OverviewKind]) -> None:
-    """The overview level ``factor`` of every band of the GeoTIFF ``base``, computed from it in row
-    windows of whole cells (so exactly as :func:`reduce_block` of the whole band)."""
+def _write_overviews(base: str, folder: str, factors: Sequence[int], kinds: Sequence[OverviewKind]) -> list[str]:
+    """Every overview level (``factors``: 2, 4, 8, ...) of every band of the GeoTIFF ``base``, one file a
+    level in ``folder``, in ONE pass over it: a row window of whole cells of the largest level is read,
+    its sums and counts pooled 2 x 2 from level to level (:func:`reduce_block`, the same arithmetic)."""
+    import contextlib
+
     import rasterio
     from rasterio.windows import Window
 
-    with rasterio.open(base) as src:
+    if list(factors) != [2 ** k for k in range(1, len(factors) + 1)]:
+        raise ProductError(f"overview factors {list(factors)} are not 2, 4, 8, ...")
+    names = [f"ov{f}.tif" for f in factors]
+    with rasterio.open(base) as src, contextlib.ExitStack() as stack:
         n, m = src.height, src.width
-        nn, mm = -(-n // factor), -(-m // factor)
-        step = factor * max(1, BLOCK // factor)  # rows per window: whole cells, at least one tile high
-        with rasterio.open(path, "w", driver="GTiff", count=src.count, dtype="float32", nodata=np.nan,
-                           height=nn, width=mm) as dst:
-            for a in range(0, n, step):
-                rows = min(step, n - a)
-                for i, kind in enumerate(kinds, start=1):
-                    cells = reduce_block(src.read(i, window=Window(0, a, m, rows)), factor, kind)
-                    dst.write(cells, i, window=Window(0, a // factor, mm, cells.shape[0]))
+        dst = [stack.enter_context(rasterio.open(os.path.join(folder, name), "w", driver="GTiff", count=src.count,
+                                                 dtype="float32", nodata=np.nan, height=-(-n // f),
+                                                 width=-(-m // f)))
+               for f, name in zip(factors, names, strict=True)]
+        step = max(max(factors), BLOCK)  # rows per window: whole cells of every level (powers of 2)
+        for a in range(0, n, step):
+            rows = min(step, n - a)
+            for i, kind in enumerate(kinds, start=1):
+                val, count = _summands(src.read(i, window=Window(0, a, m, rows)), kind)
+                for f, out in zip(factors, dst, strict=True):
+                    val, count = _pool2(val), _pool2(count)
+                    cells = _level(val, count, kind)
+                    out.write(cells, i, window=Window(0, a // f, cells.shape[1], cells.shape[0]))
+    return names
 
 
 def _attach_overviews(vrt: Path, files: Sequence[tuple[int, str]], n_bands: int) -> None:
@@ -310,11 +340,9 @@ def write_geotiff(
                 dst.update_tags(**{str(k): str(v) for k, v in tags.items()})
             for i, b in enumerate(bands, start=1):
                 dst.update_tags(i, OVERVIEW_RESAMPLING=b.overview)
-        levels = []
-        for f in overview_factors(shape):
-            name = f"ov{f}.tif"
-            _write_overview(base, os.path.join(td, name), f, [b.overview for b in bands])
-            levels.append((f, name))
+        factors = overview_factors(shape)
+        levels = list(zip(factors, _write_overviews(base, td, factors, [b.overview for b in bands]), strict=True)) \
+            if factors else []
         vrt = Path(td) / "full.vrt"
         rasterio.shutil.copy(base, vrt, driver="VRT")
         _attach_overviews(vrt, levels, len(bands))
