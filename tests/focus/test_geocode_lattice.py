@@ -13,12 +13,11 @@ import pytest
 from pyproj import Transformer
 from scipy.interpolate import LinearNDInterpolator
 
-from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
-from orbit.statevectors import StateVectors
 from sarcli.focus import geocode as G
 from sarcli.model.raw import Orbit, Radar
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import ConstantHeight
+from tests.focus.rs1_orbit import rs1_ecef_orbit
 
 C = 299792458.0
 F0, PRF, FS = 5.3e9, 1256.98, 32.317e6
@@ -27,13 +26,7 @@ F0, PRF, FS = 5.3e9, 1256.98, 32.317e6
 def _slc(n_lines: int, n_samples: int) -> SLC:
     """The geometry of a Radarsat-1 fine-beam SLC (798 km orbit, ascending through ~49 N, right
     looking, 990 km near range); no image (the tests pass the intensity)."""
-    e, inc, w = 0.00115, np.radians(98.594), np.radians(90.0)
-    nu = np.arcsin(np.sin(np.radians(49.0)) / np.sin(inc)) - w
-    ea = 2 * np.arctan(np.sqrt((1 - e) / (1 + e)) * np.tan(nu / 2))
-    r0, v0 = kepler_to_state(Keplerian(7167.1e3, e, inc, 0.0, w, ea - e * np.sin(ea)))
-    t = np.arange(-60.0, 61.0, 10.0)
-    r, v = propagate_j2(r0, v0, t)
-    sv = StateVectors(t, r, v, "ECI", "2002-06-16T00:00:00Z").to_ecef()
+    sv = rs1_ecef_orbit()
     radar = Radar(F0, C / F0, PRF, FS, -0.72e12, 42e-6, 2 * 990e3 / C, 990e3)
     z = np.zeros(0)
     return SLC(image=np.zeros((0, 0), np.complex64), azimuth_time=(np.arange(n_lines) - n_lines / 2) / PRF,

@@ -10,24 +10,12 @@ import numpy as np
 import pytest
 
 from orbit.geodetic import ecef_to_geodetic, geodetic_to_ecef
-from orbit.propagate import Keplerian, kepler_to_state, propagate_j2
-from orbit.statevectors import StateVectors
 from sarcli.errors import ProductError
 from sarcli.focus.geolocation import TERRAIN_TOL_M, geolocate_on_terrain
 from sarcli.model.terrain import ConstantHeight
+from tests.focus.rs1_orbit import rs1_ecef_orbit
 
 LAM = 299792458.0 / 5.3e9
-
-
-def _orbit() -> StateVectors:
-    """A RADARSAT-1-like orbit (798 km, sun-synchronous inclination), ascending through ~49 N at t = 0."""
-    e, inc, w = 0.00115, np.radians(98.594), np.radians(90.0)
-    nu = np.arcsin(np.sin(np.radians(49.0)) / np.sin(inc)) - w
-    ea = 2 * np.arctan(np.sqrt((1 - e) / (1 + e)) * np.tan(nu / 2))
-    r0, v0 = kepler_to_state(Keplerian(7167.1e3, e, inc, 0.0, w, ea - e * np.sin(ea)))
-    t = np.arange(-60.0, 61.0, 10.0)
-    r, v = propagate_j2(r0, v0, t)
-    return StateVectors(t, r, v, "ECI", "2002-06-16T00:00:00Z").to_ecef()
 
 
 class TiltedPlane:
@@ -46,7 +34,7 @@ class TiltedPlane:
 
 
 def _scene():
-    sv = _orbit()
+    sv = rs1_ecef_orbit()
     t0, rho0 = 0.0, 1000e3
     centre = geolocate_on_terrain(sv, t0, rho0, LAM, 0.0, "right", ConstantHeight(0.0))
     r, v, _ = sv.interpolate(np.array([t0]))
