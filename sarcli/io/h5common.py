@@ -100,9 +100,11 @@ def cf_time_units(epoch_utc: str) -> str:
     return "seconds since " + parse_utc(epoch_utc).strftime("%Y-%m-%dT%H:%M:%S.%f")
 
 
-#: finished hashes by file version (device, inode, size, modification time in ns): one product's
-#: several images (the focus's two GeoTIFFs of one SLC) read a large input once
+#: finished hashes by file version (device, inode, size, modification time in ns), the most recent
+#: :data:`_HASHED_KEPT`: one product's several images (the focus's two GeoTIFFs of one SLC) read a large
+#: input once, and a process that runs for months (gbsar monitor) keeps a bounded table
 _hashed: dict[tuple[int, int, int, int], str] = {}
+_HASHED_KEPT = 64
 
 
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22, stop: threading.Event | None = None) -> str:
@@ -118,6 +120,8 @@ def sha256_file(path: str | os.PathLike, chunk: int = 1 << 22, stop: threading.E
                 return ""
             h.update(block)
     _hashed[key] = h.hexdigest()
+    while len(_hashed) > _HASHED_KEPT:
+        del _hashed[next(iter(_hashed))]  # the oldest (dicts keep insertion order)
     return _hashed[key]
 
 

@@ -151,8 +151,9 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
 
 
 def _summands(data: np.ndarray, kind: OverviewKind) -> tuple[np.ndarray, np.ndarray]:
-    """(the per-pixel terms of the level's mean: a^2, 10^(x/10), exp(j x) or x, 0 where not finite;
-    1 where finite, else 0): cells of every level are sums of these, so one level makes the next."""
+    """(the per-pixel terms of an overview cell's mean (module docstring): a^2, 10^(x/10), exp(j x) or x,
+    0 where not finite; 1 where finite, else 0). A cell of factor f sums f x f of them (partial cells at
+    the edges, of size ceil(n / f) as GDAL's levels): one level's sums make the next."""
     a = np.asarray(data, np.float64)
     ok = np.isfinite(a)
     x = np.where(ok, a, 0.0)
@@ -188,18 +189,6 @@ def _level(val: np.ndarray, count: np.ndarray, kind: OverviewKind) -> np.ndarray
     return out.astype(np.float32)
 
 
-def reduce_block(data: np.ndarray, factor: int, kind: OverviewKind) -> np.ndarray:
-    """One overview level: ``factor`` x ``factor`` cells (``factor`` a power of 2; partial cells at the
-    edges kept, of size ceil(n / factor) as GDAL's levels), reduced as ``kind`` says (module docstring),
-    NaN ignored. The cells' sums and counts are pooled 2 x 2 level after level (exact: sums add)."""
-    if factor < 2 or factor & (factor - 1):
-        raise ProductError(f"overview factor {factor} is not a power of 2")
-    val, count = _summands(data, kind)
-    while factor > 1:
-        val, count, factor = _pool2(val), _pool2(count), factor // 2
-    return _level(val, count, kind)
-
-
 def overview_factors(shape: tuple[int, int], block: int = BLOCK) -> list[int]:
     """Factors 2, 4, ... until the reduced image fits one ``block`` x ``block`` tile."""
     out, f = [], 2
@@ -231,7 +220,8 @@ def _band_strips(bands: Sequence[Band], shape: tuple[int, int]) -> Iterator[tupl
 def _write_overviews(base: str, folder: str, factors: Sequence[int], kinds: Sequence[OverviewKind]) -> list[str]:
     """Every overview level (``factors``: 2, 4, 8, ...) of every band of the GeoTIFF ``base``, one file a
     level in ``folder``, in ONE pass over it: a row window of whole cells of the largest level is read,
-    its sums and counts pooled 2 x 2 from level to level (:func:`reduce_block`, the same arithmetic)."""
+    its per-pixel terms (:func:`_summands`) summed over 2 x 2 cells level after level with their counts
+    (exact: sums add), each level's mean taken from them (:func:`_level`)."""
     import contextlib
 
     import rasterio

@@ -32,8 +32,9 @@ from sarcli.io.scan import read_scan
 from sarcli.monitor.campaign import Campaign, read_campaign_json, scan_time
 from sarcli.monitor.config import MonitorConfig, load_monitor_config, parse_monitor_config
 from sarcli.monitor.store import fsync_path
-from sarcli.workflows.base import Progress, Report, no_progress, using
+from sarcli.workflows.base import Progress, no_progress, using
 from sarcli.workflows.gbsar_common import parameters
+from sarcli.workflows.gbsar_series import CampaignReport
 
 
 @dataclass(frozen=True)
@@ -81,26 +82,16 @@ def _iso(posix_s: float) -> str:
 
 
 @dataclass
-class GbsarMonitorReport(Report):
-    """The campaign's summary; ``records``: one per scan processed by this run."""
+class GbsarMonitorReport(CampaignReport):
+    """The campaign's summary (:class:`CampaignReport`), and whether this run was interrupted and what it
+    recovered from an earlier one's interruption."""
 
-    out: str
-    n_scans: int = 0
-    n_accepted: int = 0
-    n_rejected: int = 0
-    n_failed: int = 0
-    alarm_level: str = "none"
     interrupted: bool = False
     recovered: list[str] = field(default_factory=list)
-    records: list[dict[str, Any]] = field(default_factory=list)
 
     def raise_for_status(self) -> None:
         if self.interrupted:
             raise Interrupted(f"interrupted; {self.out} keeps {self.n_scans} scans; run the same command to resume")
-
-    def lines(self) -> list[str]:
-        return [f"{self.out}: {self.n_scans} scans ({self.n_accepted} accepted, {self.n_rejected} rejected, "
-                f"{self.n_failed} failed), alarm level {self.alarm_level}"]
 
 
 def start_campaign(root: Path, cfg: MonitorConfig, every_s: float, time_scale: float, start_utc: str | None,
@@ -204,11 +195,7 @@ def run(config: Config, provenance=None, progress: Progress | None = None,
                 k += 1
             report.interrupted = report.interrupted or ctrl_c.requested
         camp.checkpoint()
-        st = camp.state
-        if st is not None:
-            report.n_scans, report.n_accepted = st.last_scan, st.n_accepted
-            report.n_rejected, report.n_failed = st.n_rejected, st.n_failed
-            report.alarm_level = st.last_accepted_record.get("alarm_level", "none")
+        report.count(camp)
         return report
 
 

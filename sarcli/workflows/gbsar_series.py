@@ -54,7 +54,11 @@ class Config:
 
 
 @dataclass
-class GbsarSeriesReport(Report):
+class CampaignReport(Report):
+    """A campaign's summary (``gbsar monitor`` and ``gbsar series``): its scans by outcome, from the
+    campaign's state, and the alarm level of the last accepted scan; ``records``: the scans this run
+    processed."""
+
     out: str
     n_scans: int = 0
     n_accepted: int = 0
@@ -63,9 +67,23 @@ class GbsarSeriesReport(Report):
     alarm_level: str = "none"
     records: list[dict[str, Any]] = field(default_factory=list)
 
+    def count(self, camp: Campaign) -> None:
+        """Take the counts and the alarm level from the campaign's state (none yet: unchanged)."""
+        s = camp.state
+        if s is not None:
+            self.n_scans, self.n_accepted, self.n_rejected, self.n_failed = (s.last_scan, s.n_accepted,
+                                                                             s.n_rejected, s.n_failed)
+            self.alarm_level = s.last_accepted_record.get("alarm_level", "none")
+
     def lines(self) -> list[str]:
-        return [f"rebuilt {self.out}: {self.n_scans} scans ({self.n_accepted} accepted, {self.n_rejected} rejected, "
+        return [f"{self.out}: {self.n_scans} scans ({self.n_accepted} accepted, {self.n_rejected} rejected, "
                 f"{self.n_failed} failed), alarm level {self.alarm_level}"]
+
+
+@dataclass
+class GbsarSeriesReport(CampaignReport):
+    def lines(self) -> list[str]:
+        return ["rebuilt " + line for line in super().lines()]
 
 
 def campaign_scans(folder: Path) -> list[Path]:
@@ -158,11 +176,7 @@ def run(config: Config, provenance=None, progress: Progress | None = None,
                         pending.append((nxt, pool.submit(focus_file, str(scans[nxt]), cfg, *grid)))
         camp.checkpoint()
         camp.write_page()
-        s = camp.state
         rep = GbsarSeriesReport(out=str(out), records=camp.records)
-        if s is not None:
-            rep.n_scans, rep.n_accepted, rep.n_rejected, rep.n_failed = s.last_scan, s.n_accepted, s.n_rejected, \
-                s.n_failed
-            rep.alarm_level = s.last_accepted_record.get("alarm_level", "none")
+        rep.count(camp)
         return rep
 
