@@ -71,19 +71,34 @@ OUTSIDE, LATTICE, EXACT = 0, 1, 2
 
 
 def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.ndarray:
-    """Mean intensity |z|^2 over looks_az x looks_rg cells (float32; partial cells at the end dropped)."""
+    """Mean intensity |z|^2 over looks_az x looks_rg cells (float32; partial cells at the end dropped).
+    Each cell is summed in float64 by one thread in a fixed order (:func:`_multilook`): a cell's value
+    depends only on its own pixels, not on the rows around it nor on the thread count."""
     if looks_az < 1 or looks_rg < 1:
         raise SarcliError("looks must be positive integers")
     n, m = image.shape[0] // looks_az, image.shape[1] // looks_rg
     if n < 1 or m < 1:
         raise SarcliError(f"image {image.shape} is smaller than one {looks_az} x {looks_rg} look cell")
+    image = np.asarray(image)
+    if not np.iscomplexobj(image):
+        image = image.astype(np.complex128)
+    return _multilook(image, looks_az, looks_rg)
+
+
+@njit(cache=True, parallel=True)
+def _multilook(image: np.ndarray, la: int, lr: int) -> np.ndarray:
+    n, m = image.shape[0] // la, image.shape[1] // lr
     out = np.empty((n, m), np.float32)
-    step = max(1, 4096 // looks_az)
-    for a in range(0, n, step):
-        b = min(n, a + step)
-        blk = image[a * looks_az:b * looks_az, :m * looks_rg]
-        p = (blk.real.astype(np.float32) ** 2 + blk.imag.astype(np.float32) ** 2)
-        out[a:b] = p.reshape(b - a, looks_az, m, looks_rg).mean(axis=(1, 3))
+    scale = 1.0 / (la * lr)
+    for c in prange(n):
+        acc = np.zeros(m)
+        for r in range(c * la, (c + 1) * la):
+            for j in range(m):
+                for k in range(j * lr, (j + 1) * lr):
+                    z = image[r, k]
+                    acc[j] += np.float64(z.real) * np.float64(z.real) + np.float64(z.imag) * np.float64(z.imag)
+        for j in range(m):
+            out[c, j] = acc[j] * scale
     return out
 
 

@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit, prange
 
 from sarcli.errors import ProductError, SarcliError
 
@@ -251,19 +252,37 @@ def image_statistics(blocks) -> dict:
     return statistics_from_sums(sum((line_sums(b).sum(axis=0) for b in blocks), np.zeros(4)))
 
 
-def line_sums(block: np.ndarray, rows: int = 256) -> np.ndarray:
+def line_sums(block: np.ndarray) -> np.ndarray:
     """Per line of ``block`` (lines x samples, complex): (n_pixels, sum I, sum I^2, sum I ln I), float64
-    (lines, 4), I = |z|^2 (0 ln 0 = 0). The statistics of any set of lines are those of the sums of
-    their rows (:func:`statistics_from_sums`): a focused block's sums are computed as it streams past,
-    in any order. Worked in chunks of ``rows`` lines (bounded temporaries)."""
+    (lines, 4), I = |z|^2 = re^2 + im^2 in float64 (0 ln 0 = 0). The statistics of any set of lines are
+    those of the sums of their rows (:func:`statistics_from_sums`): a focused block's sums are computed
+    as it streams past, in any order. One pass (:func:`_line_sums`), every line summed by one thread in
+    sample order: the sums do not depend on the thread count."""
     block = np.asarray(block)
-    out = np.empty((block.shape[0], 4))
-    out[:, 0] = block.shape[1]
-    for a in range(0, block.shape[0], rows):
-        inten = (np.abs(block[a:a + rows]) ** 2).astype(np.float64)
-        out[a:a + rows, 1] = inten.sum(axis=1)
-        out[a:a + rows, 2] = np.einsum("ij,ij->i", inten, inten)
-        out[a:a + rows, 3] = np.einsum("ij,ij->i", inten, np.log(np.where(inten > 0, inten, 1.0)))
+    if not np.iscomplexobj(block):
+        block = block.astype(np.complex128)
+    return _line_sums(block)
+
+
+@njit(cache=True, parallel=True)
+def _line_sums(block: np.ndarray) -> np.ndarray:
+    n, m = block.shape
+    out = np.empty((n, 4))
+    for i in prange(n):
+        s1 = 0.0
+        s2 = 0.0
+        sl = 0.0
+        for j in range(m):
+            z = block[i, j]
+            x = np.float64(z.real) * np.float64(z.real) + np.float64(z.imag) * np.float64(z.imag)
+            s1 += x
+            s2 += x * x
+            if x > 0.0:
+                sl += x * np.log(x)
+        out[i, 0] = m
+        out[i, 1] = s1
+        out[i, 2] = s2
+        out[i, 3] = sl
     return out
 
 

@@ -415,6 +415,7 @@ def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, t
     k0 = taps // 2 - 1
     nl = lines_c.shape[0]
     nc = cols_c.shape[0]
+    zero = np.zeros(1, img.dtype)[0]  # the accumulator in the image's precision
     # the input lines any tap can reach: mu is bilinear between the coarse values, so within their range
     r0 = max(0, pad + int(np.floor(np.min(mu_c))) - k0)
     r1 = min(n_in, pad + n_out + int(np.ceil(np.max(mu_c))) + taps)
@@ -474,9 +475,13 @@ def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, t
                     n0 = int(np.floor(p))
                     jp = int((p - n0) * nph + 0.5)
                     b = n0 - k0
-                    acc = img[0, 0] * 0
-                    for tap in range(max(0, -b), min(taps, n_in - b)):
-                        acc += img[b + tap, i] * table[jp, tap]
+                    acc = zero
+                    if b >= 0 and b + taps <= n_in:  # every tap inside the block: a fixed-length loop
+                        for tap in range(taps):
+                            acc += img[b + tap, i] * table[jp, tap]
+                    else:
+                        for tap in range(max(0, -b), min(taps, n_in - b)):
+                            acc += img[b + tap, i] * table[jp, tap]
                     out[j, i] = acc * cur[q]
                     cur[q] *= rot[q]
 
