@@ -404,8 +404,8 @@ def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, t
     frequency dictates (the same shift in the frequency domain is exp(-j 2 pi f dt) with the absolute f).
     Computed as exp(j 2 pi c p) sum_m (s[m] exp(-j 2 pi c m)) h(p - m): each input sample is
     demodulated once (a per-column phasor advanced line by line in complex128: 1e-16 per step), and a
-    pixel costs ``taps`` real-weighted multiply-adds in the image's precision and one complex
-    multiply (the remodulation, a rotation advanced line by line; the former form, a complex
+    pixel costs ``taps`` real-weighted multiply-adds (two real ones each, summed in float64) and one
+    complex multiply (the remodulation, a rotation advanced line by line; the former form, a complex
     rotation per tap and two sines/cosines per pixel, was several times slower: bench_parallel).
     """
     n_out, nr = out.shape
@@ -415,7 +415,6 @@ def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, t
     k0 = taps // 2 - 1
     nl = lines_c.shape[0]
     nc = cols_c.shape[0]
-    zero = np.zeros(1, img.dtype)[0]  # the accumulator in the image's precision
     # the input lines any tap can reach: mu is bilinear between the coarse values, so within their range
     r0 = max(0, pad + int(np.floor(np.min(mu_c))) - k0)
     r1 = min(n_in, pad + n_out + int(np.ceil(np.max(mu_c))) + taps)
@@ -475,14 +474,23 @@ def correct_lines(img, pad, first, out, lines_c, cols_c, phi_c, mu_c, carrier, t
                     n0 = int(np.floor(p))
                     jp = int((p - n0) * nph + 0.5)
                     b = n0 - k0
-                    acc = zero
+                    # real weights on the real and imaginary parts (a complex-by-real product in numba
+                    # is a full complex multiply), accumulated in float64
+                    acc_re = 0.0
+                    acc_im = 0.0
                     if b >= 0 and b + taps <= n_in:  # every tap inside the block: a fixed-length loop
                         for tap in range(taps):
-                            acc += img[b + tap, i] * table[jp, tap]
+                            s = img[b + tap, i]
+                            w = table[jp, tap]
+                            acc_re += s.real * w
+                            acc_im += s.imag * w
                     else:
                         for tap in range(max(0, -b), min(taps, n_in - b)):
-                            acc += img[b + tap, i] * table[jp, tap]
-                    out[j, i] = acc * cur[q]
+                            s = img[b + tap, i]
+                            w = table[jp, tap]
+                            acc_re += s.real * w
+                            acc_im += s.imag * w
+                    out[j, i] = complex(acc_re, acc_im) * cur[q]
                     cur[q] *= rot[q]
 
 
