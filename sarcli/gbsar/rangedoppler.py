@@ -43,6 +43,7 @@ yardstick and the benchmark's), so the images agree within float32 rounding (tes
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,6 +55,7 @@ from sarcli.gbsar.deramp import uniform_step
 from sarcli.gbsar.rangecomp import RangeProfiles
 from sarcli.gbsar.system import next_pow2
 from sarcli.gbsar.windows import taper
+from sarcli.threads import fft_workers
 
 
 @dataclass
@@ -144,10 +146,10 @@ def _result(prof: RangeProfiles, pl: _Plan, out: np.ndarray) -> RDImage:
 
 
 @njit(cache=True, parallel=True)
-def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, h, h_rail):
-    """Rows ``j`` of the reference ``h[j]`` (the chirp of eq. 19 over the footprint ``|x| <= lam R0/(2 L_x)``,
+def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, refs):
+    """Row ``j`` of the reference ``refs[j, 0]`` (the chirp of eq. 19 over the footprint ``|x| <= lam R0/(2 L_x)``,
     or weighted by the two-way pattern ``sinc^2(L_x sin(a)/lam)`` over its main lobe ``|sin(a)| < lam/L_x``)
-    and of the unit scatterer at the rail centre ``h_rail[j]`` (the footprint chirp on the rail: rail
+    and of the unit scatterer at the rail centre ``refs[j, 1]`` (the footprint chirp on the rail: rail
     taper in region II, rail support in region I), at the circular lags ``offs`` (``k dx`` at index k,
     ``-k dx`` at index n - k). complex64; the phase ``-4 pi (R - R0)/lam`` in float64 with
     ``R - R0 = x^2/(R + R0)``. Both are even in x: each |x| is evaluated once, and only up to the reach
@@ -165,10 +167,9 @@ def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, h, h_rail):
         k_end = n // 2 + 1
         if reach / offs[1] < k_end:
             k_end = min(k_end, int(reach / offs[1]) + 2)
-        h[j, :] = 0
-        h_rail[j, :] = 0
+        refs[j, :, :] = 0
         for k in range(k_end):
-            x = -offs[n - k] if k > 0 else 0.0  # k dx, exactly (the lag grid is an integer times dx)
+            x = offs[k] if k < n_pos else -offs[n - k]  # k dx, exactly (the lag grid is an integer times dx)
             rr = np.sqrt(r * r + x * x)
             ph = -k4 * (x * x / (rr + r)) if rr > 0 else 0.0
             c = np.cos(ph)
@@ -183,13 +184,16 @@ def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, h, h_rail):
                     v = np.complex64(complex(p * c, p * s))
             elif foot:
                 v = np.complex64(complex(c, s))
-            for i in (k, n - k):
-                if (i == k and k >= n_pos) or (i == n - k and (k == 0 or k > n // 2)):
-                    continue
-                h[j, i] = v
-                wr = w_rail_lag[i] if far else (1.0 if w_rail_lag[i] > 0 else 0.0)
-                if foot and wr != 0.0:
-                    h_rail[j, i] = np.complex64(complex(wr * c, wr * s))
+            if k < n_pos:
+                refs[j, 0, k] = v
+                if foot:
+                    wr = w_rail_lag[k] if far else (1.0 if w_rail_lag[k] > 0 else 0.0)
+                    refs[j, 1, k] = np.complex64(complex(wr * c, wr * s))
+            if 0 < k <= n // 2:
+                refs[j, 0, n - k] = v
+                if foot:
+                    wr = w_rail_lag[n - k] if far else (1.0 if w_rail_lag[n - k] > 0 else 0.0)
+                    refs[j, 1, n - k] = np.complex64(complex(wr * c, wr * s))
 
 
 @njit(cache=True)
@@ -226,35 +230,41 @@ def _median_inplace(a):
 
 
 @njit(cache=True, parallel=True)
-def _filter_rows(spec, lo, r0, dr, cos_t, band_idx, wu, power, floor_rel, hs, hs_rail, out):
-    """Per row ``j``: the filter ``conj(H)/max(|H|^p, floor) * W`` over the band (floor: ``floor_rel`` x the
-    median of ``|H|^p`` over the band), the gain ``Re sum_u FFT(h_rail) filter / n``, and into ``out[j]``
-    the RCMC'd data spectrum (row ``R0/cos(theta(u))``, linear interpolation between the rows of
-    ``spec``, which start at row ``lo``) times the filter, divided by the gain (0 where the gain is not
-    positive and off the band). ``out[j]`` is then the spectrum of the image row."""
-    n = hs.shape[1]
+def _filters(refs, band_idx, wu, power, floor_rel, filt):
+    """Per row ``j`` (``refs[j]`` = the spectra H of the reference and of the rail-centre scatterer): the
+    filter ``conj(H)/max(|H|^p, floor) * W`` over the band (floor: ``floor_rel`` x the median of ``|H|^p``
+    over the band), divided by the gain ``Re sum_u FFT(h_rail) filter / n`` into ``filt[j]`` (band
+    order; all 0 where the gain is not positive)."""
+    n = refs.shape[2]
     nb = band_idx.size
-    n_spec = spec.shape[0]
-    for j in prange(r0.size):
+    for j in prange(refs.shape[0]):
         mag = np.empty(nb, np.float32)
         for q in range(nb):
-            v = hs[j, band_idx[q]]
+            v = refs[j, 0, band_idx[q]]
             m2 = v.real * v.real + v.imag * v.imag
             mag[q] = np.sqrt(m2) if power == 1 else m2
         floor = np.float32(floor_rel * _median_inplace(mag.copy()) + 1e-30)
-        filt = np.empty(nb, np.complex64)
         gain = 0.0
         for q in range(nb):
             u = band_idx[q]
-            f = np.conj(hs[j, u]) * np.float32(wu[u] / max(mag[q], floor))
-            filt[q] = f
-            gain += (hs_rail[j, u] * f).real
+            f = np.conj(refs[j, 0, u]) * np.float32(wu[u] / max(mag[q], floor))
+            filt[j, q] = f
+            gain += (refs[j, 1, u] * f).real
         gain /= n
-        out[j, :] = 0
-        if not gain > 0:
-            continue
-        g = np.float32(1.0 / gain)
+        g = np.float32(1.0 / gain) if gain > 0 else np.float32(0.0)
         for q in range(nb):
+            filt[j, q] *= g
+
+
+@njit(cache=True, parallel=True)
+def _apply(spec, lo, r0, dr, cos_t, band_idx, filt, out):
+    """Per row ``j``: into ``out[j]`` the RCMC'd data spectrum (row ``R0/cos(theta(u))``, linear
+    interpolation between the rows of ``spec``, which start at row ``lo``) times ``filt[j]`` over the
+    band, 0 elsewhere. ``out[j]`` is then the spectrum of the image row."""
+    n_spec = spec.shape[0]
+    for j in prange(r0.size):
+        out[j, :] = 0
+        for q in range(band_idx.size):
             u = band_idx[q]
             if cos_t[u] <= 0:
                 continue
@@ -263,7 +273,15 @@ def _filter_rows(spec, lo, r0, dr, cos_t, band_idx, wu, power, floor_rel, hs, hs
             if i0 < n_spec - 1:
                 t = np.float32(fr - i0)
                 i = int(i0)
-                out[j, u] = (spec[i, u] * (np.float32(1) - t) + spec[i + 1, u] * t) * filt[q] * g
+                out[j, u] = (spec[i, u] * (np.float32(1) - t) + spec[i + 1, u] * t) * filt[j, q]
+
+
+def _fft_rows(a: np.ndarray, workers: int, inverse: bool = False) -> None:
+    """FFT (or inverse FFT) of ``a`` along its last axis, into ``a`` (scipy.fft transforms in place when
+    allowed to overwrite; copied back otherwise)."""
+    res = (scipy.fft.ifft if inverse else scipy.fft.fft)(a, axis=-1, overwrite_x=True, workers=workers)
+    if not np.may_share_memory(res, a):
+        a[...] = res
 
 
 def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = None,
@@ -275,28 +293,52 @@ def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = 
     ``sinc`` = the chirp weighted by the two-way sinc^2 pattern over its main lobe (matches a real
     aperture antenna; the rect reference's Fresnel ripples, inverted, would leave a -27 dB azimuth
     sidelobe plateau on data seen through a sinc beam). ``workers``: FFT threads (scipy's convention,
-    -1 = every core); the numba kernels use numba's thread pool."""
-    pl = _plan(prof, antenna_length_m, n_xfft, azimuth_window, max_range_m, reference)
-    n, r, lam = pl.n, prof.ranges_m, prof.wavelength_m
+    counted from the thread budget of :mod:`sarcli.threads`); the numba kernels use numba's pool."""
+    return focus_rd_pols([prof], antenna_length_m, n_xfft, azimuth_window, max_range_m, block_rows, reference,
+                         workers)[0]
+
+
+def focus_rd_pols(profs: Sequence[RangeProfiles], antenna_length_m: float, n_xfft: int | None = None,
+                  azimuth_window: str = "hamming", max_range_m: float | None = None,
+                  block_rows: int = 256, reference: str = "sinc", workers: int = -1) -> list[RDImage]:
+    """:func:`focus_rd` of several profiles on the same rail stops and range bins (the polarizations of
+    one scan): the filters depend on the geometry only, so each row block's reference spectra, median
+    and gain are computed once and applied to every profile."""
+    if not profs:
+        raise SarcliError("no range profiles to focus with RD")
+    p0 = profs[0]
+    for p in profs[1:]:
+        if (p.dr_m != p0.dr_m or p.wavelength_m != p0.wavelength_m or p.data.shape[1] != p0.data.shape[1]
+                or p.first_range_m != p0.first_range_m or not np.array_equal(p.positions_m, p0.positions_m)):
+            raise SarcliError("RD of several profiles needs the same rail stops, range bins and wavelength in each")
+    pl = _plan(p0, antenna_length_m, n_xfft, azimuth_window, max_range_m, reference)
+    n, r, lam, dr = pl.n, p0.ranges_m, p0.wavelength_m, p0.dr_m
+    fw = fft_workers(workers)
     band_idx = np.flatnonzero(pl.band)
-    out = np.empty((pl.n_rows, n), np.complex64)
-    for rows in _blocks(r[:pl.n_rows], block_rows, pl.boundary):
-        r0 = r[rows]
+    blocks = _blocks(r[:pl.n_rows], block_rows, pl.boundary)
+    m_max = max(b.size for b in blocks)
+    his = [min(r.size, int(np.ceil(r[b[-1]] * pl.stretch / dr)) + 2) for b in blocks]
+    refs = np.empty((m_max, 2, n), np.complex64)
+    filt = np.empty((m_max, band_idx.size), np.complex64)
+    spec_buf = np.empty((max(hi - b[0] for b, hi in zip(blocks, his, strict=True)), n), np.complex64)
+    outs = [np.empty((pl.n_rows, n), np.complex64) for _ in profs]
+    for rows, hi in zip(blocks, his, strict=True):
+        r0, m, lo = r[rows], rows.size, rows[0]
         far = bool(r0[0] >= pl.boundary)
-        lo, hi = rows[0], min(r.size, int(np.ceil(r0[-1] * pl.stretch / prof.dr_m)) + 2)
-        spec = np.zeros((hi - lo, n), np.complex64)
-        wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
-        spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
-        spec = scipy.fft.fft(spec, axis=1, overwrite_x=True, workers=workers)
-        refs = np.empty((2, rows.size, n), np.complex64)
-        _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag,
-                    refs[0], refs[1])
-        refs = scipy.fft.fft(refs, axis=2, overwrite_x=True, workers=workers)
-        block = out[rows[0]:rows[-1] + 1]
-        _filter_rows(spec, lo, r0, prof.dr_m, pl.cos_t, band_idx, pl.band.astype(np.float64) if far else pl.w_beam,
-                     1 if far else 2, _INVERSE_FLOOR, refs[0], refs[1], block)
-        block[...] = scipy.fft.ifft(block, axis=1, overwrite_x=True, workers=workers)
-    return _result(prof, pl, out)
+        _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag, refs[:m])
+        _fft_rows(refs[:m], fw)
+        _filters(refs[:m], band_idx, pl.band.astype(np.float64) if far else pl.w_beam, 1 if far else 2,
+                 _INVERSE_FLOOR, filt[:m])
+        for prof, out in zip(profs, outs, strict=True):
+            spec = spec_buf[:hi - lo]
+            spec[...] = 0
+            wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
+            spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
+            _fft_rows(spec, fw)
+            block = out[lo:lo + m]
+            _apply(spec, lo, r0, dr, pl.cos_t, band_idx, filt[:m], block)
+            _fft_rows(block, fw, inverse=True)
+    return [_result(prof, pl, out) for prof, out in zip(profs, outs, strict=True)]
 
 
 def focus_rd_reference(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = None,

@@ -75,8 +75,9 @@ def test_reference_rows_match_numpy(sinc, far):
     offs = np.where(np.arange(n) < n - n // 2, np.arange(n), np.arange(n) - n) * dx
     r0 = np.array([0.0, 0.3, 2.0, 7.5, 40.0])
     w_rail_lag = np.interp(offs, np.linspace(-1.0, 1.0, 41), np.hanning(41), left=0.0, right=0.0)
-    h, h_rail = np.empty((2, r0.size, n), np.complex64)
-    _references(r0, offs, LAM, lx, sinc, far, w_rail_lag, h, h_rail)
+    refs = np.empty((r0.size, 2, n), np.complex64)
+    _references(r0, offs, LAM, lx, sinc, far, w_rail_lag, refs)
+    h, h_rail = refs[:, 0], refs[:, 1]
     rr = np.sqrt(r0[:, None] ** 2 + offs[None, :] ** 2)
     chirp = np.exp(-4j * np.pi * (rr - r0[:, None]) / LAM)
     foot = np.abs(offs[None, :]) <= LAM * r0[:, None] / (2 * lx)
