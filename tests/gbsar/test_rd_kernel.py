@@ -17,8 +17,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from sarcli.errors import SarcliError
 from sarcli.gbsar.rangecomp import RangeProfiles
-from sarcli.gbsar.rangedoppler import _median_inplace, _references, focus_rd, focus_rd_reference
+from sarcli.gbsar.rangedoppler import _median_inplace, _references, focus_rd, focus_rd_pols, focus_rd_reference
 from sarcli.model.constants import C_LIGHT
 
 EPS32 = 2.0 ** -24
@@ -65,6 +66,30 @@ def test_rd_matches_reference_with_a_given_fft_size_and_range_limit():
     b = focus_rd_reference(prof, 0.25, n_xfft=1024, max_range_m=15.0)
     assert a.data.shape == (151, 1024)
     assert np.linalg.norm(a.data - b.data) <= _tolerance(1024) * np.linalg.norm(b.data)
+
+
+@settings(max_examples=8, deadline=None)
+@given(seeds=st.lists(st.integers(0, 2**31), min_size=2, max_size=3),
+       skipped=st.lists(st.sampled_from([(), (0, 5), (20,)]), min_size=3, max_size=3),
+       reference=st.sampled_from(["sinc", "rect"]), block_rows=st.sampled_from([7, 256]))
+def test_rd_of_several_profiles_matches_each_numpy_reference(seeds, skipped, reference, block_rows):
+    """The polarizations of a scan share the filters, not their data or their skipped stops: each image
+    is the numpy reference's of its own profile."""
+    profs = [_profiles(s, skipped=k) for s, k in zip(seeds, skipped, strict=False)]
+    kw = dict(antenna_length_m=0.25, block_rows=block_rows, reference=reference)
+    for prof, a in zip(profs, focus_rd_pols(profs, **kw), strict=True):
+        b = focus_rd_reference(prof, **kw)
+        assert np.linalg.norm(a.data - b.data) <= _tolerance(a.n_xfft) * np.linalg.norm(b.data)
+
+
+def test_rd_of_several_profiles_refuses_other_geometries():
+    a = _profiles(1)
+    with pytest.raises(SarcliError, match="same rail stops"):
+        focus_rd_pols([a, _profiles(2, dx=0.04)], 0.25)
+    with pytest.raises(SarcliError, match="same rail stops"):
+        focus_rd_pols([a, _profiles(2, n_r=121)], 0.25)
+    with pytest.raises(SarcliError, match="no range profiles"):
+        focus_rd_pols([], 0.25)
 
 
 @pytest.mark.parametrize("sinc", [True, False])
