@@ -19,7 +19,14 @@ from hypothesis import strategies as st
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.rangecomp import RangeProfiles
-from sarcli.gbsar.rangedoppler import _median_inplace, _references, focus_rd, focus_rd_pols, focus_rd_reference
+from sarcli.gbsar.rangedoppler import (
+    _cos_sin,
+    _median_inplace,
+    _references,
+    focus_rd,
+    focus_rd_pols,
+    focus_rd_reference,
+)
 from sarcli.model.constants import C_LIGHT
 
 EPS32 = 2.0 ** -24
@@ -122,3 +129,15 @@ def test_reference_rows_match_numpy(sinc, far):
 def test_median_selection_matches_numpy(values, dtype):
     a = np.asarray(values, dtype)
     assert _median_inplace(a.copy()) == np.median(a)
+
+
+@settings(max_examples=300, deadline=None)
+@given(ph=st.one_of(st.floats(-10.0, 10.0), st.floats(-1.6e6, 1.6e6), st.floats(-1e12, 1e12),
+                    st.integers(-4000, 4000).map(lambda q: q * np.pi / 4)))
+def test_inline_cos_sin_matches_numpy(ph):
+    """Reduction by q pi/2 with pi/2 in three parts (exact products while |q| < 2^20) and Taylor kernels
+    with remainders < 5e-17 on |t| <= pi/4: a few units of 2^-53, plus about the rounding |ph| 2^-53
+    of the argument itself beyond |q| = 2^20 (where the head product is no longer exact)."""
+    c, s = _cos_sin(ph)
+    tol = 8 * 2.0 ** -53 + (abs(ph) * 2.0 ** -52 if abs(ph) >= 1.6e6 else 0.0)
+    assert abs(c - np.cos(ph)) <= tol and abs(s - np.sin(ph)) <= tol
