@@ -31,24 +31,32 @@ samples (zero padding): memory ``N_Rfft x N_xfft x 8`` bytes, the paper's 128 MB
 azimuth FFTs are done in blocks of range rows (each FFT over x is independent per range bin), so the
 peak working memory is a block of ``N_xfft`` x ``block_rows`` plus the output image.
 
-Implementation (:func:`focus_rd`): complex64 throughout, rows of the image contiguous (every FFT runs
-along contiguous memory, on ``workers`` threads), the reference rows synthesized by a numba kernel
-(phase in float64, ``R - R0 = x^2 / (R + R0)`` without cancellation) and FFT'd with the rail-limited
-reference of the gain in one call; one fused numba pass per row then forms the filter over the band
-(median of ``|H|^p`` by selection), the gain, the RCMC interpolation and the filtered spectrum
-divided by the gain, so the block's output rows need only their IFFT. Same arithmetic as the plain
-numpy :func:`focus_rd_reference` (complex128 reference, ``nanmedian`` per column; the test's
-yardstick and the benchmark's), so the images agree within float32 rounding (tests/gbsar).
+Implementation (:func:`focus_rd`, :func:`focus_rd_pols`): complex64 throughout, rows of the image
+contiguous (every FFT runs along contiguous memory, in place in buffers reused from block to block, on
+the ``workers`` threads of the budget), the reference rows synthesized by a numba kernel (phase in
+float64, ``R - R0 = x^2 / (R + R0)`` without cancellation, its cos/sin by an inline reduction and
+Taylor kernels so that the loop vectorizes) and FFT'd with the rail-limited reference of the gain in
+one call; a numba pass per row forms the filter over the band (median of ``|H|^p`` by selection)
+divided by the gain. The filter depends on the geometry only (rail stops, range bins, wavelength),
+so :func:`focus_rd_pols` builds it once per row block for all the polarizations of a scan, and per
+polarization a second numba pass forms the RCMC interpolation times the filter, so the block's
+output rows need only their IFFT. The exact sampled reference spectrum is kept (see above: no
+closed form). The arithmetic is that of the plain numpy :func:`focus_rd_reference` (complex128
+reference, ``nanmedian`` per column, one polarization at a time; the test's yardstick and the
+benchmark's) up to the order of the float32 roundings, so the images agree within float32 rounding
+(tests/gbsar).
 """
 
 from __future__ import annotations
 
+import queue
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
-from numba import njit, prange
+from numba import njit
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.deramp import uniform_step
@@ -153,7 +161,7 @@ _PIO2_MID = np.pi / 2 - _PIO2_HI
 _PIO2_LO = float(np.cos(np.pi / 2))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _cos_sin(ph):
     """(cos ph, sin ph) of a float64 ``ph`` without a library call, so that loops over it vectorize:
     ``ph = q pi/2 + t`` with ``q = rint(2 ph/pi)``, ``|t| <= pi/4`` (pi/2 in three parts: t exact to
@@ -175,7 +183,7 @@ def _cos_sin(ph):
     return (-cq if m == 1.0 or m == 2.0 else cq), (-sq if m >= 2.0 else sq)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, refs):
     """Row ``j`` of the reference ``refs[j, 0]`` (the chirp of eq. 19 over the footprint ``|x| <= lam R0/(2 L_x)``,
     or weighted by the two-way pattern ``sinc^2(L_x sin(a)/lam)`` over its main lobe ``|sin(a)| < lam/L_x``)
@@ -195,7 +203,7 @@ def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, refs):
     for k in range(n // 2 + 1):
         if w_rail_lag[k % n] != 0.0 or w_rail_lag[(n - k) % n] != 0.0:
             k_rail = k + 1
-    for j in prange(r0.size):
+    for j in range(r0.size):
         r = r0[j]
         half = lam * r / (2.0 * lx)
         reach = half
@@ -233,7 +241,7 @@ def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, refs):
                     refs[j, 1, i] = np.complex64(complex(wr * c[k], wr * s[k]))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _median_inplace(a):
     """Median of the float array ``a`` (reordered in place): the mean of the two middle values for an even
     size, as ``numpy.median``; Hoare's selection for the upper middle, the maximum of the part below it
@@ -270,7 +278,7 @@ def _median_inplace(a):
     return 0.5 * (np.float64(lower) + upper)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _filters(refs, band_idx, wu, power, floor_rel, filt):
     """Per row ``j`` (``refs[j]`` = the spectra H of the reference and of the rail-centre scatterer): the
     filter ``conj(H)/max(|H|^p, floor) * W`` over the band (floor: ``floor_rel`` x the median of ``|H|^p``
@@ -278,7 +286,7 @@ def _filters(refs, band_idx, wu, power, floor_rel, filt):
     order; all 0 where the gain is not positive)."""
     n = refs.shape[2]
     nb = band_idx.size
-    for j in prange(refs.shape[0]):
+    for j in range(refs.shape[0]):
         mag = np.empty(nb, np.float32)
         for q in range(nb):
             v = refs[j, 0, band_idx[q]]
@@ -297,13 +305,13 @@ def _filters(refs, band_idx, wu, power, floor_rel, filt):
             filt[j, q] *= g
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _apply(spec, lo, r0, dr, cos_t, band_idx, filt, out):
     """Per row ``j``: into ``out[j]`` the RCMC'd data spectrum (row ``R0/cos(theta(u))``, linear
     interpolation between the rows of ``spec``, which start at row ``lo``) times ``filt[j]`` over the
     band, 0 elsewhere. ``out[j]`` is then the spectrum of the image row."""
     n_spec = spec.shape[0]
-    for j in prange(r0.size):
+    for j in range(r0.size):
         out[j, :] = 0
         for q in range(band_idx.size):
             u = band_idx[q]
@@ -341,10 +349,14 @@ def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = 
 
 def focus_rd_pols(profs: Sequence[RangeProfiles], antenna_length_m: float, n_xfft: int | None = None,
                   azimuth_window: str = "hamming", max_range_m: float | None = None,
-                  block_rows: int = 256, reference: str = "sinc", workers: int = -1) -> list[RDImage]:
+                  block_rows: int = 128, reference: str = "sinc", workers: int = -1) -> list[RDImage]:
     """:func:`focus_rd` of several profiles on the same rail stops and range bins (the polarizations of
     one scan): the filters depend on the geometry only, so each row block's reference spectra, median
-    and gain are computed once and applied to every profile."""
+    and gain are computed once and applied to every profile.
+
+    The row blocks go to a pool of ``workers`` threads (scipy's convention, counted from the thread
+    budget of :mod:`sarcli.threads`), each with its own buffers, serial GIL-free kernels and
+    single-threaded FFTs: no synchronization inside a block, so a busy machine slows it gracefully."""
     if not profs:
         raise SarcliError("no range profiles to focus with RD")
     p0 = profs[0]
@@ -354,31 +366,46 @@ def focus_rd_pols(profs: Sequence[RangeProfiles], antenna_length_m: float, n_xff
             raise SarcliError("RD of several profiles needs the same rail stops, range bins and wavelength in each")
     pl = _plan(p0, antenna_length_m, n_xfft, azimuth_window, max_range_m, reference)
     n, r, lam, dr = pl.n, p0.ranges_m, p0.wavelength_m, p0.dr_m
-    fw = fft_workers(workers)
     band_idx = np.flatnonzero(pl.band)
     blocks = _blocks(r[:pl.n_rows], block_rows, pl.boundary)
-    m_max = max(b.size for b in blocks)
     his = [min(r.size, int(np.ceil(r[b[-1]] * pl.stretch / dr)) + 2) for b in blocks]
-    refs = np.empty((m_max, 2, n), np.complex64)
-    filt = np.empty((m_max, band_idx.size), np.complex64)
-    spec_buf = np.empty((max(hi - b[0] for b, hi in zip(blocks, his, strict=True)), n), np.complex64)
+    m_max = max(b.size for b in blocks)
+    spec_rows = max(hi - b[0] for b, hi in zip(blocks, his, strict=True))
     outs = [np.empty((pl.n_rows, n), np.complex64) for _ in profs]
-    for rows, hi in zip(blocks, his, strict=True):
-        r0, m, lo = r[rows], rows.size, rows[0]
-        far = bool(r0[0] >= pl.boundary)
-        _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag, refs[:m])
-        _fft_rows(refs[:m], fw)
-        _filters(refs[:m], band_idx, pl.band.astype(np.float64) if far else pl.w_beam, 1 if far else 2,
-                 _INVERSE_FLOOR, filt[:m])
-        for prof, out in zip(profs, outs, strict=True):
-            spec = spec_buf[:hi - lo]
-            spec[...] = 0
-            wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
-            spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
-            _fft_rows(spec, fw)
-            block = out[lo:lo + m]
-            _apply(spec, lo, r0, dr, pl.cos_t, band_idx, filt[:m], block)
-            _fft_rows(block, fw, inverse=True)
+    n_threads = min(fft_workers(workers), len(blocks))
+    buffers: queue.SimpleQueue = queue.SimpleQueue()
+    for _ in range(n_threads):
+        buffers.put((np.empty((m_max, 2, n), np.complex64), np.empty((m_max, band_idx.size), np.complex64),
+                     np.empty((spec_rows, n), np.complex64)))
+
+    def run(rows: np.ndarray, hi: int) -> None:
+        buf = buffers.get()
+        try:
+            r0, m, lo = r[rows], rows.size, int(rows[0])
+            far = bool(r0[0] >= pl.boundary)
+            refs, filt, spec = buf[0][:m], buf[1][:m], buf[2][:hi - lo]
+            _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag, refs)
+            _fft_rows(refs, 1)
+            _filters(refs, band_idx, pl.band.astype(np.float64) if far else pl.w_beam, 1 if far else 2,
+                     _INVERSE_FLOOR, filt)
+            for prof, out in zip(profs, outs, strict=True):
+                wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
+                spec[...] = 0
+                spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
+                _fft_rows(spec, 1)
+                block = out[lo:lo + m]
+                _apply(spec, lo, r0, dr, pl.cos_t, band_idx, filt, block)
+                _fft_rows(block, 1, inverse=True)
+        finally:
+            buffers.put(buf)
+
+    if n_threads == 1:
+        for rows, hi in zip(blocks, his, strict=True):
+            run(rows, hi)
+    else:
+        with ThreadPoolExecutor(n_threads) as pool:
+            for f in [pool.submit(run, rows, hi) for rows, hi in zip(blocks, his, strict=True)]:
+                f.result()
     return [_result(prof, pl, out) for prof, out in zip(profs, outs, strict=True)]
 
 
