@@ -11,9 +11,10 @@ call (scipy.fft scratch is not counted), next to Table 1's ``N_Rfft x N_xfft x 8
 Goals: outdoor (1601 x 101) DF < 50 ms, BP over the 600 m image < 2 s, auto as sharp as BP
 everywhere at no more than twice DF's time plus the near-range part.
 
-RD core vs a naive numpy RD: ``focus_rd`` (complex64 numba kernels) against
-``focus_rd_reference`` (the plain-numpy implementation it replaced: complex128 reference per block,
-``nanmedian`` per column) on both polarizations of samples/gbsar_outdoor.toml, 600 m image, in
+RD core vs a naive numpy RD: ``focus_rd_pols`` (complex64 numba kernels, both polarizations in one
+call: the filters, which depend on the geometry only, built once) against ``focus_rd_reference`` (the
+plain-numpy implementation it replaced: complex128 reference per block, ``nanmedian`` per column, one
+polarization after the other) on both polarizations of samples/gbsar_outdoor.toml, 600 m image, in
 interleaved rounds (best of each), with the normwise difference of the images.
 
 PS coherence (docs/parallel.md, "GB-SAR time series"): ``sarcli gbsar coherence`` on N image products of the
@@ -258,8 +259,10 @@ def main() -> None:
                           "near pos err m", "near |amp vs BP| dB", "far II pos err m",
                           "far II |amp vs BP| dB", "far II |phase vs BP| deg", "worst PSLR dB"], rows),
           "\n## RD core vs a naive numpy RD (samples/gbsar_outdoor.toml, both polarizations, 600 m)\n",
-          "`focus_rd` (complex64 numba kernels, FFTs along contiguous rows on all cores) against "
-          "`focus_rd_reference` (plain numpy: complex128 reference chirp per block, `nanmedian` per column), "
+          "`focus_rd_pols` (complex64 numba kernels; both polarizations in one call, the filters built once "
+          "per row block; row blocks on a pool of threads, single-threaded FFTs along contiguous rows) against "
+          "`focus_rd_reference` (plain numpy: complex128 reference chirp per block, `nanmedian` per column, "
+          "one polarization after the other), "
           "same range-compressed profiles, interleaved rounds, best of each; difference = "
           "||numba - numpy|| / ||numpy|| over the image (float32 rounding; tests/gbsar/test_rd_kernel.py). "
           "`focus_scan` = the whole `--algorithm rd` focus of both polarizations onto the default grid.\n",
@@ -270,7 +273,7 @@ def main() -> None:
           "array is half of Table 1's; RD runs on 2x oversampled range bins, so its output array is Table 1's.\n",
           markdown_table(["config", "DF array", "Table 1 DF MB", "DF array MB", "DF numpy peak MB",
                           "RC + DF core ms", "geometric correction ms", "RD array", "Table 1 RD MB", "RD array MB",
-                          "RD numpy peak MB (output + 256-row blocks)", "RD core s"], core_rows),
+                          "RD numpy peak MB (output + 128-row blocks per thread)", "RD core s"], core_rows),
           "\n## PS coherence: block-wise vs whole stack\n",
           "`gbsar coherence` reads every image product by blocks of rows (one block of each image at a time; "
           "the coherence and mean-amplitude maps are kept whole) instead of stacking all images; same result "

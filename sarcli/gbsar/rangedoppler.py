@@ -335,14 +335,14 @@ def _fft_rows(a: np.ndarray, workers: int, inverse: bool = False) -> None:
 
 def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = None,
              azimuth_window: str = "hamming", max_range_m: float | None = None,
-             block_rows: int = 256, reference: str = "sinc", workers: int = -1) -> RDImage:
+             block_rows: int = 128, reference: str = "sinc", workers: int = -1) -> RDImage:
     """RD image of the range rows up to ``max_range_m`` (default: all), processed in row blocks.
 
     ``reference``: ``rect`` = the paper's chirp over the beam footprint (matches the ideal beam);
     ``sinc`` = the chirp weighted by the two-way sinc^2 pattern over its main lobe (matches a real
     aperture antenna; the rect reference's Fresnel ripples, inverted, would leave a -27 dB azimuth
-    sidelobe plateau on data seen through a sinc beam). ``workers``: FFT threads (scipy's convention,
-    counted from the thread budget of :mod:`sarcli.threads`); the numba kernels use numba's pool."""
+    sidelobe plateau on data seen through a sinc beam). ``workers``: threads, as in
+    :func:`focus_rd_pols`."""
     return focus_rd_pols([prof], antenna_length_m, n_xfft, azimuth_window, max_range_m, block_rows, reference,
                          workers)[0]
 
