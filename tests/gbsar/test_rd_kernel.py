@@ -67,9 +67,11 @@ def test_rd_matches_numpy_reference(seed, reference, window, block_rows, skipped
     assert err <= _tolerance(a.n_xfft), err
 
 
-def test_rd_matches_reference_with_a_given_fft_size_and_range_limit():
+@pytest.mark.parametrize("workers", [1, 3])
+def test_rd_matches_reference_with_a_given_fft_size_and_range_limit(workers):
+    """Serially and with the row blocks on a pool of three threads (whatever the cores)."""
     prof = _profiles(3, n_r=200)
-    a = focus_rd(prof, 0.25, n_xfft=1024, max_range_m=15.0, workers=1)
+    a = focus_rd(prof, 0.25, n_xfft=1024, max_range_m=15.0, block_rows=16, workers=workers)
     b = focus_rd_reference(prof, 0.25, n_xfft=1024, max_range_m=15.0)
     assert a.data.shape == (151, 1024)
     assert np.linalg.norm(a.data - b.data) <= _tolerance(1024) * np.linalg.norm(b.data)
