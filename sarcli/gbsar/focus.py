@@ -33,7 +33,7 @@ from sarcli.gbsar.backprojection import backproject, backproject_grid
 from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
 from sarcli.gbsar.rail import ordered
 from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress, wave_speed
-from sarcli.gbsar.rangedoppler import focus_rd, rd_n_xfft
+from sarcli.gbsar.rangedoppler import focus_rd_pols, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
 from sarcli.gbsar.windows import parse_taper
 from sarcli.model.gbsar import Scan
@@ -238,19 +238,26 @@ def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
     return part, cov, n
 
 
-def _rd(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions, antenna_length_m: float,
-        n_xfft: int | None) -> tuple[np.ndarray, np.ndarray, int]:
-    prof = range_compress(scan, pol, opts.range_window, opts.rd_oversample,
-                          max_range_m=float(grid.ranges[rows][-1]) * 1.05 + 1.0, permittivity=opts.permittivity)
-    img = focus_rd(prof, antenna_length_m, n_xfft, opts.azimuth_window,
-                   max_range_m=float(grid.ranges[rows][-1]) + 1e-9, reference=opts.rd_reference)
+def _rd(scan: Scan, pols: tuple[str, ...], grid: Grid, rows: np.ndarray, opts: FocusOptions,
+        antenna_length_m: float, n_xfft: int | None) -> tuple[list[tuple[np.ndarray, np.ndarray]], int]:
+    """RD of every polarization at once (the filters are shared, :func:`focus_rd_pols`), sampled onto
+    the grid's rows and azimuths: ``[(part, covered)]`` per polarization, and N_xfft."""
+    profs = [range_compress(scan, pol, opts.range_window, opts.rd_oversample,
+                            max_range_m=float(grid.ranges[rows][-1]) * 1.05 + 1.0, permittivity=opts.permittivity)
+             for pol in pols]
+    imgs = focus_rd_pols(profs, antenna_length_m, n_xfft, opts.azimuth_window,
+                         max_range_m=float(grid.ranges[rows][-1]) + 1e-9, reference=opts.rd_reference)
+    img = imgs[0]
     ri = np.rint(grid.ranges[rows] / img.ranges_m[1]).astype(np.int64) if img.ranges_m.size > 1 else \
         np.zeros(rows.size, np.int64)
     ci = np.rint((grid.azimuths - img.azimuth_first_m) / img.dx_m).astype(np.int64)
     ok_c = (ci >= 0) & (ci < img.n_xfft)
-    out = np.zeros((rows.size, grid.azimuths.size), np.complex64)
-    out[:, ok_c] = img.data[np.clip(ri, 0, img.data.shape[0] - 1)][:, ci[ok_c]]
-    return out, np.broadcast_to(ok_c, out.shape).copy(), img.n_xfft
+    parts = []
+    for im in imgs:
+        out = np.zeros((rows.size, grid.azimuths.size), np.complex64)
+        out[:, ok_c] = im.data[np.clip(ri, 0, im.data.shape[0] - 1)][:, ci[ok_c]]
+        parts.append((out, np.broadcast_to(ok_c, out.shape).copy()))
+    return parts, img.n_xfft
 
 
 def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None = None,
@@ -291,24 +298,26 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     image = np.zeros((len(pols), grid.ranges.size, grid.azimuths.size), np.complex64)
     timings: dict[str, float] = {}
     n_xfft_used: dict[str, int] = {}
-    for ip, pol in enumerate(pols):
-        for name, rows in alg_plan.items():
-            t0 = time.perf_counter()
+    for name, rows in alg_plan.items():
+        t0 = time.perf_counter()
+        if name == "rd":
+            n = opts.n_xfft
+            if n is None:  # cover the grid's width at its far rows (and the paper's rule)
+                dx = float(np.median(np.diff(x)))
+                width_n = (grid.azimuths[-1] - grid.azimuths[0]) / dx + 2 * x.size
+                n = max(rd_n_xfft(prof0.wavelength_m, float(grid.ranges[rows][-1]), dx, x.size),
+                        next_pow2(width_n))
+            rd_parts, n_xfft_used["rd"] = _rd(scan, pols, grid, rows, opts, lx, n)
+        for ip, pol in enumerate(pols):
             if name == "bp":
                 part, cov = _bp(scan, pol, grid, rows, opts), np.ones((rows.size, grid.azimuths.size), bool)
             elif name == "df":
                 part, cov, n_xfft_used["df"] = _df(scan, pol, grid, rows, opts)
             else:
-                n = opts.n_xfft
-                if n is None:  # cover the grid's width at its far rows (and the paper's rule)
-                    dx = float(np.median(np.diff(x)))
-                    width_n = (grid.azimuths[-1] - grid.azimuths[0]) / dx + 2 * x.size
-                    n = max(rd_n_xfft(prof0.wavelength_m, float(grid.ranges[rows][-1]), dx, x.size),
-                            next_pow2(width_n))
-                part, cov, n_xfft_used["rd"] = _rd(scan, pol, grid, rows, opts, lx, n)
-            timings[name] = timings.get(name, 0.0) + time.perf_counter() - t0
+                part, cov = rd_parts[ip]
             image[ip, rows] = np.where(cov, part, 0)
             amap[rows] = np.where(cov, ALG_CODE[name], 0)
+        timings[name] = time.perf_counter() - t0
     report = {
         "algorithm": opts.algorithm,
         "used": {k: [float(grid.ranges[v][0]), float(grid.ranges[v][-1])] for k, v in alg_plan.items()},

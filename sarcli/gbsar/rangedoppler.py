@@ -31,29 +31,39 @@ samples (zero padding): memory ``N_Rfft x N_xfft x 8`` bytes, the paper's 128 MB
 azimuth FFTs are done in blocks of range rows (each FFT over x is independent per range bin), so the
 peak working memory is a block of ``N_xfft`` x ``block_rows`` plus the output image.
 
-Implementation (:func:`focus_rd`): complex64 throughout, rows of the image contiguous (every FFT runs
-along contiguous memory, on ``workers`` threads), the reference rows synthesized by a numba kernel
-(phase in float64, ``R - R0 = x^2 / (R + R0)`` without cancellation) and FFT'd with the rail-limited
-reference of the gain in one call; one fused numba pass per row then forms the filter over the band
-(median of ``|H|^p`` by selection), the gain, the RCMC interpolation and the filtered spectrum
-divided by the gain, so the block's output rows need only their IFFT. Same arithmetic as the plain
-numpy :func:`focus_rd_reference` (complex128 reference, ``nanmedian`` per column; the test's
-yardstick and the benchmark's), so the images agree within float32 rounding (tests/gbsar).
+Implementation (:func:`focus_rd`, :func:`focus_rd_pols`): complex64 throughout, rows of the image
+contiguous (every FFT runs along contiguous memory, in place in buffers reused from block to block, on
+the ``workers`` threads of the budget), the reference rows synthesized by a numba kernel (phase in
+float64, ``R - R0 = x^2 / (R + R0)`` without cancellation, its cos/sin by an inline reduction and
+Taylor kernels so that the loop vectorizes) and FFT'd with the rail-limited reference of the gain in
+one call; a numba pass per row forms the filter over the band (median of ``|H|^p`` by selection)
+divided by the gain. The filter depends on the geometry only (rail stops, range bins, wavelength),
+so :func:`focus_rd_pols` builds it once per row block for all the polarizations of a scan, and per
+polarization a second numba pass forms the RCMC interpolation times the filter, so the block's
+output rows need only their IFFT. The exact sampled reference spectrum is kept (see above: no
+closed form). The arithmetic is that of the plain numpy :func:`focus_rd_reference` (complex128
+reference, ``nanmedian`` per column, one polarization at a time; the test's yardstick and the
+benchmark's) up to the order of the float32 roundings, so the images agree within float32 rounding
+(tests/gbsar).
 """
 
 from __future__ import annotations
 
+import queue
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
-from numba import njit, prange
+from numba import njit
 
 from sarcli.errors import SarcliError
 from sarcli.gbsar.deramp import uniform_step
 from sarcli.gbsar.rangecomp import RangeProfiles
 from sarcli.gbsar.system import next_pow2
 from sarcli.gbsar.windows import taper
+from sarcli.threads import fft_workers
 
 
 @dataclass
@@ -143,65 +153,108 @@ def _result(prof: RangeProfiles, pl: _Plan, out: np.ndarray) -> RDImage:
                    dx_m=pl.dx, n_xfft=pl.n)
 
 
-@njit(cache=True, parallel=True)
-def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, h, h_rail):
-    """Rows ``j`` of the reference ``h[j]`` (the chirp of eq. 19 over the footprint ``|x| <= lam R0/(2 L_x)``,
+# pi/2 = _PIO2_HI + _PIO2_MID + _PIO2_LO: a head with its low 20 mantissa bits cleared (33 significant bits,
+# so q * _PIO2_HI is exact for |q| < 2^20), the rest of the double pi/2, and pi/2 - double(pi/2) (which is
+# cos(double(pi/2)) to double precision).
+_PIO2_HI = float(np.array(np.array(np.pi / 2).view(np.int64) & ~np.int64((1 << 20) - 1)).view(np.float64))
+_PIO2_MID = np.pi / 2 - _PIO2_HI
+_PIO2_LO = float(np.cos(np.pi / 2))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _cos_sin(ph):
+    """(cos ph, sin ph) of a float64 ``ph`` without a library call, so that loops over it vectorize:
+    ``ph = q pi/2 + t`` with ``q = rint(2 ph/pi)``, ``|t| <= pi/4`` (pi/2 in three parts: t exact to
+    ~1e-16 |q| 2^-53 while ``|q| < 2^20``, else to about the rounding ``|ph| 2^-53`` that ph itself
+    carries), the Taylor series of sin t to t^15 and of cos t to t^16 (remainders below
+    ``(pi/4)^17/17! = 5e-17``), and the quadrant ``q mod 4`` by selection. Error ~ 1e-15 where
+    ``|ph| < 1.6e6``."""
+    q = np.rint(ph * (2.0 / np.pi))
+    t = ((ph - q * _PIO2_HI) - q * _PIO2_MID) - q * _PIO2_LO
+    z = t * t
+    s = t * (1.0 + z * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880 + z * (
+        -1.0 / 39916800 + z * (1.0 / 6227020800 + z * (-1.0 / 1307674368000))))))))
+    c = 1.0 + z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320 + z * (-1.0 / 3628800 + z * (
+        1.0 / 479001600 + z * (-1.0 / 87178291200 + z * (1.0 / 20922789888000))))))))
+    m = q - 4.0 * np.floor(0.25 * q)  # q mod 4, exactly
+    odd = m == 1.0 or m == 3.0
+    cq = s if odd else c
+    sq = c if odd else s
+    return (-cq if m == 1.0 or m == 2.0 else cq), (-sq if m >= 2.0 else sq)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _references(r0, offs, lam, lx, sinc, far, w_rail_lag, refs):
+    """Row ``j`` of the reference ``refs[j, 0]`` (the chirp of eq. 19 over the footprint ``|x| <= lam R0/(2 L_x)``,
     or weighted by the two-way pattern ``sinc^2(L_x sin(a)/lam)`` over its main lobe ``|sin(a)| < lam/L_x``)
-    and of the unit scatterer at the rail centre ``h_rail[j]`` (the footprint chirp on the rail: rail
+    and of the unit scatterer at the rail centre ``refs[j, 1]`` (the footprint chirp on the rail: rail
     taper in region II, rail support in region I), at the circular lags ``offs`` (``k dx`` at index k,
     ``-k dx`` at index n - k). complex64; the phase ``-4 pi (R - R0)/lam`` in float64 with
-    ``R - R0 = x^2/(R + R0)``. Both are even in x: each |x| is evaluated once, and only up to the reach
-    of the footprint or of the main lobe ``|x| < s0 R0/sqrt(1 - s0^2)``, ``s0 = lam/L_x`` (zero beyond)."""
+    ``R - R0 = x^2/(R + R0)``. Both are even in x: each |x| is evaluated once (a loop without branches
+    or library calls, that vectorizes), and only up to the reach of the footprint or of the main lobe
+    ``|x| < s0 R0/sqrt(1 - s0^2)``, ``s0 = lam/L_x`` (zero beyond); the rail-centre row only over the
+    lags where the rail taper is not 0."""
     n = offs.size
     n_pos = n - n // 2  # indices 0 .. n_pos-1 hold the lags 0, dx, ...; n_pos .. n-1 the negative ones
+    dx = offs[1]
     k4 = 4.0 * np.pi / lam
     s0 = lam / lx
-    for j in prange(r0.size):
+    k_rail = 0  # the rail taper is 0 at lags >= k_rail dx on both sides
+    for k in range(n // 2 + 1):
+        if w_rail_lag[k % n] != 0.0 or w_rail_lag[(n - k) % n] != 0.0:
+            k_rail = k + 1
+    for j in range(r0.size):
         r = r0[j]
         half = lam * r / (2.0 * lx)
         reach = half
         if sinc:
             reach = max(half, s0 * r / np.sqrt(1.0 - s0 * s0)) if s0 < 1.0 else np.inf
         k_end = n // 2 + 1
-        if reach / offs[1] < k_end:
-            k_end = min(k_end, int(reach / offs[1]) + 2)
-        h[j, :] = 0
-        h_rail[j, :] = 0
+        if reach / dx < k_end:
+            k_end = min(k_end, int(reach / dx) + 2)
+        c = np.empty(k_end)
+        s = np.empty(k_end)
+        p = np.empty(k_end)
         for k in range(k_end):
-            x = -offs[n - k] if k > 0 else 0.0  # k dx, exactly (the lag grid is an integer times dx)
+            x = k * dx  # = |offs| at index k and n - k, exactly (the lag grid is an integer times dx)
             rr = np.sqrt(r * r + x * x)
-            ph = -k4 * (x * x / (rr + r)) if rr > 0 else 0.0
-            c = np.cos(ph)
-            s = np.sin(ph)
-            foot = x <= half
-            v = np.complex64(0)
+            pos = rr > 0
+            c[k], s[k] = _cos_sin(-k4 * (x * x / (rr + r)) if pos else 0.0)
             if sinc:
-                sin_a = x / rr if rr > 0 else x
-                if sin_a < s0:
-                    w = np.pi * lx * sin_a / lam
-                    p = (np.sin(w) / w) ** 2 if w != 0.0 else 1.0
-                    v = np.complex64(complex(p * c, p * s))
-            elif foot:
-                v = np.complex64(complex(c, s))
-            for i in (k, n - k):
-                if (i == k and k >= n_pos) or (i == n - k and (k == 0 or k > n // 2)):
-                    continue
-                h[j, i] = v
-                wr = w_rail_lag[i] if far else (1.0 if w_rail_lag[i] > 0 else 0.0)
-                if foot and wr != 0.0:
-                    h_rail[j, i] = np.complex64(complex(wr * c, wr * s))
+                sin_a = x / rr if pos else x
+                w = np.pi * lx * sin_a / lam
+                sw = _cos_sin(w)[1] / w
+                p[k] = (sw * sw if w != 0.0 else 1.0) if sin_a < s0 else 0.0
+            else:
+                p[k] = 1.0 if x <= half else 0.0
+        refs[j, :, :] = 0
+        for k in range(k_end):
+            v = np.complex64(complex(p[k] * c[k], p[k] * s[k]))
+            if k < n_pos:
+                refs[j, 0, k] = v
+            if 0 < k <= n // 2:
+                refs[j, 0, n - k] = v
+        for k in range(min(k_end, k_rail)):
+            if k * dx <= half:  # the footprint
+                for i in (k, (n - k) % n):
+                    wr = w_rail_lag[i] if far else (1.0 if w_rail_lag[i] > 0 else 0.0)
+                    refs[j, 1, i] = np.complex64(complex(wr * c[k], wr * s[k]))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _median_inplace(a):
     """Median of the float array ``a`` (reordered in place): the mean of the two middle values for an even
-    size, as ``numpy.median``; Hoare's selection (expected linear time) for the upper middle, the
-    maximum of the part below it for the lower."""
+    size, as ``numpy.median``; Hoare's selection for the upper middle, the maximum of the part below it
+    for the lower. The pivots are drawn by a fixed 64-bit linear congruential generator, not
+    taken from the middle: expected linear time whatever the order of the values (a
+    smooth, even spectrum made the middle pivots ~4x slower); the result does not depend on them."""
     n = a.size
     k = n // 2
     lo, hi = 0, n - 1
+    state = np.uint64(0x9E3779B97F4A7C15)
     while lo < hi:
-        piv = a[(lo + hi) // 2]
+        state = state * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+        piv = a[lo + int((state >> np.uint64(33)) % np.uint64(hi - lo + 1))]
         i, j = lo, hi
         while i <= j:
             while a[i] < piv:
@@ -225,36 +278,42 @@ def _median_inplace(a):
     return 0.5 * (np.float64(lower) + upper)
 
 
-@njit(cache=True, parallel=True)
-def _filter_rows(spec, lo, r0, dr, cos_t, band_idx, wu, power, floor_rel, hs, hs_rail, out):
-    """Per row ``j``: the filter ``conj(H)/max(|H|^p, floor) * W`` over the band (floor: ``floor_rel`` x the
-    median of ``|H|^p`` over the band), the gain ``Re sum_u FFT(h_rail) filter / n``, and into ``out[j]``
-    the RCMC'd data spectrum (row ``R0/cos(theta(u))``, linear interpolation between the rows of
-    ``spec``, which start at row ``lo``) times the filter, divided by the gain (0 where the gain is not
-    positive and off the band). ``out[j]`` is then the spectrum of the image row."""
-    n = hs.shape[1]
+@njit(cache=True, nogil=True, error_model="numpy")
+def _filters(refs, band_idx, wu, power, floor_rel, filt):
+    """Per row ``j`` (``refs[j]`` = the spectra H of the reference and of the rail-centre scatterer): the
+    filter ``conj(H)/max(|H|^p, floor) * W`` over the band (floor: ``floor_rel`` x the median of ``|H|^p``
+    over the band), divided by the gain ``Re sum_u FFT(h_rail) filter / n`` into ``filt[j]`` (band
+    order; all 0 where the gain is not positive)."""
+    n = refs.shape[2]
     nb = band_idx.size
-    n_spec = spec.shape[0]
-    for j in prange(r0.size):
+    for j in range(refs.shape[0]):
         mag = np.empty(nb, np.float32)
         for q in range(nb):
-            v = hs[j, band_idx[q]]
+            v = refs[j, 0, band_idx[q]]
             m2 = v.real * v.real + v.imag * v.imag
             mag[q] = np.sqrt(m2) if power == 1 else m2
         floor = np.float32(floor_rel * _median_inplace(mag.copy()) + 1e-30)
-        filt = np.empty(nb, np.complex64)
         gain = 0.0
         for q in range(nb):
             u = band_idx[q]
-            f = np.conj(hs[j, u]) * np.float32(wu[u] / max(mag[q], floor))
-            filt[q] = f
-            gain += (hs_rail[j, u] * f).real
+            f = np.conj(refs[j, 0, u]) * np.float32(wu[u] / max(mag[q], floor))
+            filt[j, q] = f
+            gain += (refs[j, 1, u] * f).real
         gain /= n
-        out[j, :] = 0
-        if not gain > 0:
-            continue
-        g = np.float32(1.0 / gain)
+        g = np.float32(1.0 / gain) if gain > 0 else np.float32(0.0)
         for q in range(nb):
+            filt[j, q] *= g
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _apply(spec, lo, r0, dr, cos_t, band_idx, filt, out):
+    """Per row ``j``: into ``out[j]`` the RCMC'd data spectrum (row ``R0/cos(theta(u))``, linear
+    interpolation between the rows of ``spec``, which start at row ``lo``) times ``filt[j]`` over the
+    band, 0 elsewhere. ``out[j]`` is then the spectrum of the image row."""
+    n_spec = spec.shape[0]
+    for j in range(r0.size):
+        out[j, :] = 0
+        for q in range(band_idx.size):
             u = band_idx[q]
             if cos_t[u] <= 0:
                 continue
@@ -263,40 +322,91 @@ def _filter_rows(spec, lo, r0, dr, cos_t, band_idx, wu, power, floor_rel, hs, hs
             if i0 < n_spec - 1:
                 t = np.float32(fr - i0)
                 i = int(i0)
-                out[j, u] = (spec[i, u] * (np.float32(1) - t) + spec[i + 1, u] * t) * filt[q] * g
+                out[j, u] = (spec[i, u] * (np.float32(1) - t) + spec[i + 1, u] * t) * filt[j, q]
+
+
+def _fft_rows(a: np.ndarray, workers: int, inverse: bool = False) -> None:
+    """FFT (or inverse FFT) of ``a`` along its last axis, into ``a`` (scipy.fft transforms in place when
+    allowed to overwrite; copied back otherwise)."""
+    res = (scipy.fft.ifft if inverse else scipy.fft.fft)(a, axis=-1, overwrite_x=True, workers=workers)
+    if not np.may_share_memory(res, a):
+        a[...] = res
 
 
 def focus_rd(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = None,
              azimuth_window: str = "hamming", max_range_m: float | None = None,
-             block_rows: int = 256, reference: str = "sinc", workers: int = -1) -> RDImage:
+             block_rows: int = 128, reference: str = "sinc", workers: int = -1) -> RDImage:
     """RD image of the range rows up to ``max_range_m`` (default: all), processed in row blocks.
 
     ``reference``: ``rect`` = the paper's chirp over the beam footprint (matches the ideal beam);
     ``sinc`` = the chirp weighted by the two-way sinc^2 pattern over its main lobe (matches a real
     aperture antenna; the rect reference's Fresnel ripples, inverted, would leave a -27 dB azimuth
-    sidelobe plateau on data seen through a sinc beam). ``workers``: FFT threads (scipy's convention,
-    -1 = every core); the numba kernels use numba's thread pool."""
-    pl = _plan(prof, antenna_length_m, n_xfft, azimuth_window, max_range_m, reference)
-    n, r, lam = pl.n, prof.ranges_m, prof.wavelength_m
+    sidelobe plateau on data seen through a sinc beam). ``workers``: threads, as in
+    :func:`focus_rd_pols`."""
+    return focus_rd_pols([prof], antenna_length_m, n_xfft, azimuth_window, max_range_m, block_rows, reference,
+                         workers)[0]
+
+
+def focus_rd_pols(profs: Sequence[RangeProfiles], antenna_length_m: float, n_xfft: int | None = None,
+                  azimuth_window: str = "hamming", max_range_m: float | None = None,
+                  block_rows: int = 128, reference: str = "sinc", workers: int = -1) -> list[RDImage]:
+    """:func:`focus_rd` of several profiles on the same rail stops and range bins (the polarizations of
+    one scan): the filters depend on the geometry only, so each row block's reference spectra, median
+    and gain are computed once and applied to every profile.
+
+    The row blocks go to a pool of ``workers`` threads (scipy's convention, counted from the thread
+    budget of :mod:`sarcli.threads`), each with its own buffers, serial GIL-free kernels and
+    single-threaded FFTs: no synchronization inside a block, so a busy machine slows it gracefully."""
+    if not profs:
+        raise SarcliError("no range profiles to focus with RD")
+    p0 = profs[0]
+    for p in profs[1:]:
+        if (p.dr_m != p0.dr_m or p.wavelength_m != p0.wavelength_m or p.data.shape[1] != p0.data.shape[1]
+                or p.first_range_m != p0.first_range_m or not np.array_equal(p.positions_m, p0.positions_m)):
+            raise SarcliError("RD of several profiles needs the same rail stops, range bins and wavelength in each")
+    pl = _plan(p0, antenna_length_m, n_xfft, azimuth_window, max_range_m, reference)
+    n, r, lam, dr = pl.n, p0.ranges_m, p0.wavelength_m, p0.dr_m
     band_idx = np.flatnonzero(pl.band)
-    out = np.empty((pl.n_rows, n), np.complex64)
-    for rows in _blocks(r[:pl.n_rows], block_rows, pl.boundary):
-        r0 = r[rows]
-        far = bool(r0[0] >= pl.boundary)
-        lo, hi = rows[0], min(r.size, int(np.ceil(r0[-1] * pl.stretch / prof.dr_m)) + 2)
-        spec = np.zeros((hi - lo, n), np.complex64)
-        wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
-        spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
-        spec = scipy.fft.fft(spec, axis=1, overwrite_x=True, workers=workers)
-        refs = np.empty((2, rows.size, n), np.complex64)
-        _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag,
-                    refs[0], refs[1])
-        refs = scipy.fft.fft(refs, axis=2, overwrite_x=True, workers=workers)
-        block = out[rows[0]:rows[-1] + 1]
-        _filter_rows(spec, lo, r0, prof.dr_m, pl.cos_t, band_idx, pl.band.astype(np.float64) if far else pl.w_beam,
-                     1 if far else 2, _INVERSE_FLOOR, refs[0], refs[1], block)
-        block[...] = scipy.fft.ifft(block, axis=1, overwrite_x=True, workers=workers)
-    return _result(prof, pl, out)
+    blocks = _blocks(r[:pl.n_rows], block_rows, pl.boundary)
+    his = [min(r.size, int(np.ceil(r[b[-1]] * pl.stretch / dr)) + 2) for b in blocks]
+    m_max = max(b.size for b in blocks)
+    spec_rows = max(hi - b[0] for b, hi in zip(blocks, his, strict=True))
+    outs = [np.empty((pl.n_rows, n), np.complex64) for _ in profs]
+    n_threads = min(fft_workers(workers), len(blocks))
+    buffers: queue.SimpleQueue = queue.SimpleQueue()
+    for _ in range(n_threads):
+        buffers.put((np.empty((m_max, 2, n), np.complex64), np.empty((m_max, band_idx.size), np.complex64),
+                     np.empty((spec_rows, n), np.complex64)))
+
+    def run(rows: np.ndarray, hi: int) -> None:
+        buf = buffers.get()
+        try:
+            r0, m, lo = r[rows], rows.size, int(rows[0])
+            far = bool(r0[0] >= pl.boundary)
+            refs, filt, spec = buf[0][:m], buf[1][:m], buf[2][:hi - lo]
+            _references(r0, pl.offs, lam, float(antenna_length_m), reference == "sinc", far, pl.w_rail_lag, refs)
+            _fft_rows(refs, 1)
+            _filters(refs, band_idx, pl.band.astype(np.float64) if far else pl.w_beam, 1 if far else 2,
+                     _INVERSE_FLOOR, filt)
+            for prof, out in zip(profs, outs, strict=True):
+                wx = (prof.weights * (pl.w_rail if far else 1.0)).astype(np.float32)
+                spec[...] = 0
+                spec[:, pl.pad:pl.pad + pl.n_x] = (prof.data[:, lo:hi] * wx[:, None]).T
+                _fft_rows(spec, 1)
+                block = out[lo:lo + m]
+                _apply(spec, lo, r0, dr, pl.cos_t, band_idx, filt, block)
+                _fft_rows(block, 1, inverse=True)
+        finally:
+            buffers.put(buf)
+
+    if n_threads == 1:
+        for rows, hi in zip(blocks, his, strict=True):
+            run(rows, hi)
+    else:
+        with ThreadPoolExecutor(n_threads) as pool:
+            for f in [pool.submit(run, rows, hi) for rows, hi in zip(blocks, his, strict=True)]:
+                f.result()
+    return [_result(prof, pl, out) for prof, out in zip(profs, outs, strict=True)]
 
 
 def focus_rd_reference(prof: RangeProfiles, antenna_length_m: float, n_xfft: int | None = None,

@@ -17,8 +17,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from sarcli.errors import SarcliError
 from sarcli.gbsar.rangecomp import RangeProfiles
-from sarcli.gbsar.rangedoppler import _median_inplace, _references, focus_rd, focus_rd_reference
+from sarcli.gbsar.rangedoppler import (
+    _cos_sin,
+    _median_inplace,
+    _references,
+    focus_rd,
+    focus_rd_pols,
+    focus_rd_reference,
+)
 from sarcli.model.constants import C_LIGHT
 
 EPS32 = 2.0 ** -24
@@ -59,12 +67,38 @@ def test_rd_matches_numpy_reference(seed, reference, window, block_rows, skipped
     assert err <= _tolerance(a.n_xfft), err
 
 
-def test_rd_matches_reference_with_a_given_fft_size_and_range_limit():
+@pytest.mark.parametrize("workers", [1, 3])
+def test_rd_matches_reference_with_a_given_fft_size_and_range_limit(workers):
+    """Serially and with the row blocks on a pool of three threads (whatever the cores)."""
     prof = _profiles(3, n_r=200)
-    a = focus_rd(prof, 0.25, n_xfft=1024, max_range_m=15.0, workers=1)
+    a = focus_rd(prof, 0.25, n_xfft=1024, max_range_m=15.0, block_rows=16, workers=workers)
     b = focus_rd_reference(prof, 0.25, n_xfft=1024, max_range_m=15.0)
     assert a.data.shape == (151, 1024)
     assert np.linalg.norm(a.data - b.data) <= _tolerance(1024) * np.linalg.norm(b.data)
+
+
+@settings(max_examples=8, deadline=None)
+@given(seeds=st.lists(st.integers(0, 2**31), min_size=2, max_size=3),
+       skipped=st.lists(st.sampled_from([(), (0, 5), (20,)]), min_size=3, max_size=3),
+       reference=st.sampled_from(["sinc", "rect"]), block_rows=st.sampled_from([7, 256]))
+def test_rd_of_several_profiles_matches_each_numpy_reference(seeds, skipped, reference, block_rows):
+    """The polarizations of a scan share the filters, not their data or their skipped stops: each image
+    is the numpy reference's of its own profile."""
+    profs = [_profiles(s, skipped=k) for s, k in zip(seeds, skipped, strict=False)]
+    kw = dict(antenna_length_m=0.25, block_rows=block_rows, reference=reference)
+    for prof, a in zip(profs, focus_rd_pols(profs, **kw), strict=True):
+        b = focus_rd_reference(prof, **kw)
+        assert np.linalg.norm(a.data - b.data) <= _tolerance(a.n_xfft) * np.linalg.norm(b.data)
+
+
+def test_rd_of_several_profiles_refuses_other_geometries():
+    a = _profiles(1)
+    with pytest.raises(SarcliError, match="same rail stops"):
+        focus_rd_pols([a, _profiles(2, dx=0.04)], 0.25)
+    with pytest.raises(SarcliError, match="same rail stops"):
+        focus_rd_pols([a, _profiles(2, n_r=121)], 0.25)
+    with pytest.raises(SarcliError, match="no range profiles"):
+        focus_rd_pols([], 0.25)
 
 
 @pytest.mark.parametrize("sinc", [True, False])
@@ -75,8 +109,9 @@ def test_reference_rows_match_numpy(sinc, far):
     offs = np.where(np.arange(n) < n - n // 2, np.arange(n), np.arange(n) - n) * dx
     r0 = np.array([0.0, 0.3, 2.0, 7.5, 40.0])
     w_rail_lag = np.interp(offs, np.linspace(-1.0, 1.0, 41), np.hanning(41), left=0.0, right=0.0)
-    h, h_rail = np.empty((2, r0.size, n), np.complex64)
-    _references(r0, offs, LAM, lx, sinc, far, w_rail_lag, h, h_rail)
+    refs = np.empty((r0.size, 2, n), np.complex64)
+    _references(r0, offs, LAM, lx, sinc, far, w_rail_lag, refs)
+    h, h_rail = refs[:, 0], refs[:, 1]
     rr = np.sqrt(r0[:, None] ** 2 + offs[None, :] ** 2)
     chirp = np.exp(-4j * np.pi * (rr - r0[:, None]) / LAM)
     foot = np.abs(offs[None, :]) <= LAM * r0[:, None] / (2 * lx)
@@ -96,3 +131,15 @@ def test_reference_rows_match_numpy(sinc, far):
 def test_median_selection_matches_numpy(values, dtype):
     a = np.asarray(values, dtype)
     assert _median_inplace(a.copy()) == np.median(a)
+
+
+@settings(max_examples=300, deadline=None)
+@given(ph=st.one_of(st.floats(-10.0, 10.0), st.floats(-1.6e6, 1.6e6), st.floats(-1e12, 1e12),
+                    st.integers(-4000, 4000).map(lambda q: q * np.pi / 4)))
+def test_inline_cos_sin_matches_numpy(ph):
+    """Reduction by q pi/2 with pi/2 in three parts (exact products while |q| < 2^20) and Taylor kernels
+    with remainders < 5e-17 on |t| <= pi/4: a few units of 2^-53, plus about the rounding |ph| 2^-53
+    of the argument itself beyond |q| = 2^20 (where the head product is no longer exact)."""
+    c, s = _cos_sin(ph)
+    tol = 8 * 2.0 ** -53 + (abs(ph) * 2.0 ** -52 if abs(ph) >= 1.6e6 else 0.0)
+    assert abs(c - np.cos(ph)) <= tol and abs(s - np.sin(ph)) <= tol
