@@ -32,7 +32,6 @@ from dataclasses import dataclass
 import numpy as np
 from llvmlite import ir
 from numba import njit, prange, types
-from numba.core import cgutils
 from numba.extending import intrinsic
 
 from sarcli.errors import SarcliError
@@ -168,69 +167,6 @@ def _prefetch(typingctx, arr, index):
     return types.void(arr, index), codegen
 
 
-#: float32 lanes of one SIMD vector in :func:`_lag_sums` (4 complex samples; 256-bit AVX; LLVM splits
-#: it into two 128-bit halves on a CPU without AVX)
-LANES = 8
-
-
-@intrinsic
-def _lag_sums(typingctx, a, b, nv):
-    """Lag sums of the first ``nv`` vectors of 8 float32 (4 complex samples, interleaved re, im) of
-    the 1-D C-contiguous float32 arrays ``a`` (later line) and ``b`` (earlier line):
-    (sum Re(a conj b), sum Im(a conj b), sum |a|^2), float32.
-
-    Written as vector code because the compiler's own vectorization of the scalar loop de-interleaves
-    re and im (8 shuffles per 8 samples) and chains two FMAs per accumulator: here the lanes stay
-    interleaved, P += a*b (sum of all lanes: Re), Q += a*swap(b) with swap(b) = (bi, br) pairs (lanes
-    ai br at odd, ar bi at even positions: Im = odd - even), E += a*a; one in-lane shuffle and three
-    FMAs per 4 samples, two independent accumulator sets (the FMA latency is hidden).
-    Round-off: a float32 sum of terms rounded r times errs by at most r u sum|terms| (u = 2^-24, to
-    first order). Each lane here takes ceil(nv/2) fused multiply-adds and 4 additions join the 16
-    lanes: r <= nv/2 + 5, against r = 8 nv - 1 for the sequential loop of 8 nv products it replaces;
-    the error analysis of the tests (``tests/doppler/test_cde.py``) keeps its bound."""
-    if not (all(isinstance(v, types.Array) and v.dtype == types.float32 and v.ndim == 1 and v.layout == "C"
-                for v in (a, b)) and isinstance(nv, types.Integer)):
-        return None
-
-    def codegen(context, builder, signature, args):
-        fl = ir.FloatType()
-        vec = ir.VectorType(fl, LANES)
-        vp = vec.as_pointer()
-        pa = context.make_array(signature.args[0])(context, builder, args[0]).data
-        pb = context.make_array(signature.args[1])(context, builder, args[1]).data
-        n = args[2]
-        fma = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vec, [vec] * 3), f"llvm.fma.v{LANES}f32")
-        swap = ir.Constant(ir.VectorType(ir.IntType(32), LANES), [i ^ 1 for i in range(LANES)])
-        acc = [cgutils.alloca_once_value(builder, ir.Constant(vec, [0.0] * LANES)) for _ in range(6)]
-
-        def step(i, s):  # vector i into accumulator set s (P, Q, E)
-            off = builder.mul(i, i.type(LANES))
-            va = builder.load(builder.bitcast(builder.gep(pa, [off]), vp), align=4)
-            vb = builder.load(builder.bitcast(builder.gep(pb, [off]), vp), align=4)
-            for k, y in enumerate((vb, builder.shuffle_vector(vb, vb, swap), va)):
-                builder.store(builder.call(fma, [va, y, builder.load(acc[3 * s + k])]), acc[3 * s + k])
-
-        half = builder.ashr(n, n.type(1))
-        with cgutils.for_range(builder, half) as loop:
-            two = builder.mul(loop.index, n.type(2))
-            step(two, 0)
-            step(builder.add(two, n.type(1)), 1)
-        with builder.if_then(builder.icmp_signed("!=", builder.and_(n, n.type(1)), n.type(0))):
-            step(builder.mul(half, n.type(2)), 0)
-        odd_minus_even = ir.Constant(vec, [-1.0, 1.0] * (LANES // 2))
-        total = cgutils.get_or_insert_function(builder.module, ir.FunctionType(fl, [fl, vec]),
-                                               f"llvm.vector.reduce.fadd.v{LANES}f32")
-        sums = []
-        for k in range(3):
-            v = builder.fadd(builder.load(acc[k]), builder.load(acc[3 + k]))
-            if k == 1:
-                v = builder.fmul(v, odd_minus_even)
-            sums.append(builder.call(total, [fl(0.0), v], fastmath=("reassoc",)))
-        return context.make_tuple(builder, signature.return_type, sums)
-
-    return types.UniTuple(types.float32, 3)(a, b, nv), codegen
-
-
 @njit(cache=True, inline="always")
 def _line_energy(v, k0, n):
     e = np.float32(0.0)
@@ -305,9 +241,7 @@ def _lag_kernel(x, task_m0, task_m1, samp0, nsamp, sign_mode, lag, part, line_en
                     if m + lag < m1:
                         line_en[m + lag, jb] = np.float64(_line_energy(la, samp0[jb], n))
                 else:
-                    nv = 2 * n // LANES
-                    sr, si, se = _lag_sums(a, b, nv)
-                    for k in range(nv * LANES // 2, n):  # the last < 4 samples
+                    for k in range(n):
                         ar = a[2 * k]
                         ai = a[2 * k + 1]
                         br = b[2 * k]
