@@ -106,8 +106,8 @@ def section_throughput(out: dict) -> str:
             + f"\nnumba first call (compile or cache load): {t_first:.2f} s; peak RSS "
               f"{peak_rss_bytes() / 1e9:.2f} GB. The CDE runs on all cores (numba prange over tasks of "
               "256 pair lines: every thread gets an equal share), like the bound; one line's energy is "
-              "computed once; the lag sums are 8-lane vector code and the memory stream is prefetched 8 KiB "
-              f"ahead. Best of 7 interleaved rounds; load average {load:.1f} on {os.cpu_count()} cores.\n")
+              "computed once; the memory stream is prefetched 8 KiB ahead. Best of 7 interleaved rounds; "
+              f"load average {load:.1f} on {os.cpu_count()} cores.\n")
 
 
 def section_blocks(out: dict) -> str:
