@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import shutil
 import subprocess
 import sys
@@ -31,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.common import RESULTS, markdown_table, write_results
+from bench.common import RESULTS, markdown_table, peak_rss_bytes, write_results
 
 REPO = Path(__file__).resolve().parents[1]
 SARCLI = str(Path(sys.executable).parent / "sarcli")
@@ -152,7 +151,7 @@ def bench_big(tmp: Path) -> dict:
         client.run(lambda: __import__("sarcli.focus.rda"))
         wall, proc = _run(_focus_args(raw, out, "parallel") + ["--scheduler", cluster.scheduler_address], env)
         prep = json.loads(proc.stdout)
-        workers = client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+        workers = client.run(peak_rss_bytes)
     parallel = {"focus_s": wall, "client_peak_rss_bytes": prep["peak_rss_bytes"],
                 "worker_peak_rss_bytes": sorted(workers.values()),
                 "identical_to_single_process": _images_equal(out / "single0.slc.h5", out / "parallel.slc.h5"),

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import resource
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -32,8 +31,10 @@ def first_call_time(fn: Callable[[], Any]) -> float:
 
 
 def peak_rss_bytes() -> int:
-    """Peak resident set size of this process so far (bytes)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    """Peak resident set size of this process so far (bytes; :func:`sarcli.memory.peak_rss_bytes`)."""
+    from sarcli.memory import peak_rss_bytes as peak
+
+    return peak()
 
 
 def markdown_table(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:

@@ -694,7 +694,9 @@ class RangeDoppler:
         elif np.any(phi != 0.0):
             apply_line_phase(out, s, lines_c, plan.model.columns, phi)
         _add(tm, "line_correction_s", t0)
-        return out.astype(np.complex64, copy=False)
+        # C-contiguous (a view of the block buffer is not): the sink's kernels see one layout, and the
+        # HDF5 write would copy a strided block anyway
+        return np.ascontiguousarray(out, np.complex64)
 
     @staticmethod
     def line_corrections(plan: RdPlan, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

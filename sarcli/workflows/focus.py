@@ -23,7 +23,6 @@ import dataclasses
 import inspect
 import logging
 import math
-import resource
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -32,6 +31,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from sarcli.config import to_mapping
 from sarcli.errors import ConfigError, ProductError
+from sarcli.memory import peak_rss_bytes
 from sarcli.workflows.base import Progress, Provenance, Report, no_progress, refuse_overwriting_inputs, using
 
 if TYPE_CHECKING:
@@ -255,7 +255,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
                           "fr_hz_per_s_mid": float(np.median(d.fr_hz_per_s[:, mid])),
                           "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, mid]))},
             image_statistics=stats, timings_s=timings,
-            peak_rss_bytes=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, warnings=msgs,
+            peak_rss_bytes=peak_rss_bytes(), warnings=msgs,
             parameters=slc.parameters)
 
 
