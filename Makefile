@@ -47,15 +47,19 @@ test-latest:
 
 ## warm-cache: byte-compile the package (an editable install has no .pyc until a run writes them, and none
 ##   is ever written where PYTHONDONTWRITEBYTECODE is set: 0.4 s of compiling per command), then compile the
-##   numba kernels of the main commands into the per-user cache (sarcli/__init__.py) on small samples, so
-##   that the first command after install loads them instead of compiling (run by install)
+##   numba kernels of the main commands into the per-user cache (sarcli/__init__.py) on small samples (CEOS
+##   ingest, Doppler, focus with its GeoTIFF and quicklook, GB-SAR focus), so that the first command after
+##   install loads them instead of compiling (run by install; make demo then compiles nothing)
 warm-cache:
 	@rm -rf $(WARM) && mkdir -p $(WARM)
 	$(BIN)/python -m compileall -q sarcli orbit
 	$(BIN)/sarcli -q simulate samples/rs1_point.toml -o $(WARM)/raw.h5
+	$(BIN)/sarcli -q simulate samples/rs1_point.toml --format ceos -o $(WARM)/ceos
+	$(BIN)/sarcli -q ingest $(WARM)/ceos -o $(WARM)/ingested.h5
 	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
 	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
-	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5
+	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5 \
+	  --geotiff $(WARM)/slc.tif --quicklook $(WARM)/slc.png
 	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
 	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
 	@rm -rf $(WARM)

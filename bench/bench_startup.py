@@ -112,8 +112,9 @@ def section_cold(work: Path, f: dict[str, Path], out: dict) -> str:
             for k in cmds]
     return ("## B. A fresh install's first command\n\n"
             "Each command run once against an empty numba cache folder (every kernel compiled), and once "
-            "against an empty folder that `make warm-cache` (part of `make install`: simulate, doppler, "
-            "focus of samples/rs1_point.toml, gbsar focus of samples/gbsar_indoor.toml with every algorithm) "
+            "against an empty folder that `make warm-cache` (part of `make install`: byte-compile, simulate, "
+            "CEOS ingest, doppler, focus with GeoTIFF and quicklook of samples/rs1_point.toml, gbsar focus of "
+            "samples/gbsar_indoor.toml with every algorithm) "
             f"filled first, in {res['after make warm-cache']['make warm-cache']['wall_s']:.0f} s; the warm "
             "time of section A for comparison.\n\n"
             + markdown_table(["command", "empty cache: first run s", "after make warm-cache: first run s",
