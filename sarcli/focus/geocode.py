@@ -79,10 +79,7 @@ def multilook(image: np.ndarray, looks_az: int = 1, looks_rg: int = 1) -> np.nda
     n, m = image.shape[0] // looks_az, image.shape[1] // looks_rg
     if n < 1 or m < 1:
         raise SarcliError(f"image {image.shape} is smaller than one {looks_az} x {looks_rg} look cell")
-    image = np.asarray(image)
-    if not np.iscomplexobj(image):
-        image = image.astype(np.complex128)
-    return _multilook(image, looks_az, looks_rg)
+    return _multilook(np.asarray(image), looks_az, looks_rg)
 
 
 @njit(cache=True, parallel=True)

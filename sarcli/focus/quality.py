@@ -258,10 +258,7 @@ def line_sums(block: np.ndarray) -> np.ndarray:
     those of the sums of their rows (:func:`statistics_from_sums`): a focused block's sums are computed
     as it streams past, in any order. One pass (:func:`_line_sums`), every line summed by one thread in
     sample order: the sums do not depend on the thread count."""
-    block = np.asarray(block)
-    if not np.iscomplexobj(block):
-        block = block.astype(np.complex128)
-    return _line_sums(block)
+    return _line_sums(np.asarray(block))
 
 
 @njit(cache=True, parallel=True)

@@ -242,8 +242,7 @@ def write_geotiff(
             for row, values in _band_strips(bands, shape):
                 for i, v in enumerate(values, start=1):
                     dst.write(v, i, window=Window(0, row, shape[1], v.shape[0]))
-                if factors:
-                    pyramid.add(values)
+                pyramid.add(values)
             for i, b in enumerate(bands, start=1):
                 dst.set_band_description(i, b.description)
                 dst.set_band_unit(i, b.unit)

@@ -158,7 +158,7 @@ def levels_of_window(values: np.ndarray, kind: OverviewKind, n_levels: int) -> l
     out = [px]
     for _ in range(n_levels - 1):
         re, cnt = pool2(re), pool2(cnt)
-        im = pool2(im) if code == 2 else im[:re.shape[0], :re.shape[1]]
+        im = pool2(im) if code == 2 else re  # im is read for phase only
         out.append(level_pixels(re, im, cnt, code))
     return out
 
@@ -204,7 +204,9 @@ class Pyramid:
         self._stack.close()
 
     def add(self, values: Sequence[np.ndarray]) -> None:
-        """The next rows of every band (float32 arrays of equal rows)."""
+        """The next rows of every band (float32 arrays of equal rows); nothing to do without levels."""
+        if not self.factors:
+            return
         if self._held is not None:
             values = [np.concatenate([h, v]) for h, v in zip(self._held, values, strict=True)]
             self._held = None
