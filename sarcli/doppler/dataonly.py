@@ -56,7 +56,7 @@ import numpy as np
 
 from sarcli.doppler.ambiguity import rounding_confidence
 from sarcli.doppler.cde import block_correlation
-from sarcli.doppler.rangecomp import range_looks
+from sarcli.doppler.rangecomp import Looks, range_looks
 from sarcli.model.doppler_summary import DataOnlyEstimate
 from sarcli.model.raw import Radar
 
@@ -95,9 +95,10 @@ def _auto_block(rg_block: int | None, n_valid: int) -> int:
 
 
 def mlcc(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int | None = None,
-         replica: np.ndarray | None = None) -> DataOnlyEstimate:
-    """MLCC absolute centroid (Hz) and ambiguity relative to the scene baseband centroid ``fdc_bb``."""
-    lo, hi, fc = range_looks(echo, radar, replica)
+         replica: np.ndarray | None = None, looks: Looks | None = None) -> DataOnlyEstimate:
+    """MLCC absolute centroid (Hz) and ambiguity relative to the scene baseband centroid ``fdc_bb``.
+    ``looks``: the range sub-looks of ``echo`` (``range_looks``) when the caller has them already."""
+    lo, hi, fc = looks if looks is not None else range_looks(echo, radar, replica)
     n_lines = echo.shape[0]
     rg_block = _auto_block(rg_block, lo.shape[1])
     b_lo = block_correlation(lo, n_lines, rg_block)
@@ -109,12 +110,13 @@ def mlcc(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int | None = N
 
 
 def mlbf(echo: np.ndarray, radar: Radar, fdc_bb: float, rg_block: int | None = None,
-         replica: np.ndarray | None = None, lag: int = 16) -> DataOnlyEstimate:
+         replica: np.ndarray | None = None, lag: int = 16, looks: Looks | None = None) -> DataOnlyEstimate:
     """MLBF absolute centroid (Hz) and ambiguity relative to the scene baseband centroid ``fdc_bb``.
 
     The beat frequency of each range block is read from the lag-1 phase (coarse, unambiguous to
-    PRF/2) and refined by the lag-``lag`` phase unwrapped around it (module docstring)."""
-    lo, hi, fc = range_looks(echo, radar, replica)
+    PRF/2) and refined by the lag-``lag`` phase unwrapped around it (module docstring). ``looks`` as
+    for :func:`mlcc`."""
+    lo, hi, fc = looks if looks is not None else range_looks(echo, radar, replica)
     beat = lo * np.conj(hi)
     blk = _auto_block(rg_block, beat.shape[1])
     prf = radar.prf_hz

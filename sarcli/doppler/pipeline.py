@@ -35,7 +35,7 @@ from sarcli.doppler.estimators.base import BasebandBlocks, CentroidEstimator, Es
 from sarcli.doppler.geometry import OrbitGeometry
 from sarcli.doppler.options import DopplerOptions
 from sarcli.doppler.polyfit import fit_poly2d
-from sarcli.doppler.rangecomp import can_compress
+from sarcli.doppler.rangecomp import can_compress, range_looks
 from sarcli.errors import ConfigError, ProductError
 from sarcli.model.constants import C_LIGHT as C
 from sarcli.model.doppler import PolyDoppler
@@ -211,8 +211,9 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
     def run_data_only() -> tuple[int, float]:
         if not data_only and compress:
             sub = central_lines(raw.echo, options.max_lines)
-            data_only.extend([mlcc(sub, radar, fbb_scene, options.dataonly_rg_block, raw.replica),
-                              mlbf(sub, radar, fbb_scene, options.dataonly_rg_block, raw.replica)])
+            looks = range_looks(sub, radar, raw.replica)  # one pair of sub-looks for both estimators
+            data_only.extend([mlcc(sub, radar, fbb_scene, options.dataonly_rg_block, looks=looks),
+                              mlbf(sub, radar, fbb_scene, options.dataonly_rg_block, looks=looks)])
             both = combine_estimates(data_only, fbb_scene, prf)
             if both is not None:
                 data_only.append(both)

@@ -69,8 +69,11 @@ def range_compress_extended(echo: np.ndarray, radar: Radar, replica: np.ndarray 
     return out[:, idx].astype(np.complex64), slice(-half, n + half)
 
 
-def range_looks(echo: np.ndarray, radar: Radar, replica: np.ndarray | None = None
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+#: (look_lo, look_hi, centre_hz[2]): the two range sub-looks of :func:`range_looks`
+Looks = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def range_looks(echo: np.ndarray, radar: Radar, replica: np.ndarray | None = None) -> Looks:
     """Two range sub-looks (lower / upper half of the chirp band) of the range-compressed echo.
 
     Returns (look_lo, look_hi, centre_hz[2]) on the valid samples. The carrier of a look is the

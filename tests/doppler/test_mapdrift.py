@@ -7,9 +7,11 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sarcli.doppler.api import estimate_doppler
-from sarcli.doppler.mapdrift import map_drift
+from sarcli.doppler.mapdrift import _drift_lines, _unit_phasor, map_drift
 from sarcli.doppler.options import DopplerOptions
 from sarcli.doppler.rangecomp import range_compress_valid
 from sarcli.errors import SarcliError
@@ -78,3 +80,45 @@ def test_mapdrift_rate_follows_inverse_range_over_the_swath(airborne_raw, tmp_pa
     back = read_doppler(tmp_path / "d.h5")
     np.testing.assert_allclose(back.fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
     assert back.summary.fr_info.mapdrift == md and back.summary == m.summary  # typed summary round trip
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-1e4, 1e4), st.integers(0, 2**31))
+def test_unit_phasor_matches_complex128_exp(scale, seed):
+    # bound from the docstring's error budget: reduction ~1e-12, float32 phase 1e-7 rad, 2 pi product
+    # 2e-7 rad, cos/sin a few float32 ulp: 5e-7 in all (1e-6 allows for the ulp count of numpy's SIMD)
+    turns = np.random.default_rng(seed).uniform(-1.0, 1.0, (7, 33)) * scale
+    got = _unit_phasor(turns)
+    assert got.dtype == np.complex64
+    np.testing.assert_array_less(np.abs(got - np.exp(2j * np.pi * turns)), 1e-6)
+
+
+def _drift_lines_numpy(i1, i2):
+    """Plain float64 reference: circular cross-correlation of the mean-removed columns, summed over
+    range, parabolic peak."""
+    a = i1 - i1.mean(axis=0)
+    b = i2 - i2.mean(axis=0)
+    n = a.shape[0]
+    xc = sum(np.array([np.dot(np.roll(b[:, j], -lag), a[:, j]) for lag in range(n)]) for j in range(a.shape[1]))
+    k = int(np.argmax(xc))
+    y0, y1, y2 = xc[(k - 1) % n], xc[k], xc[(k + 1) % n]
+    s = k + 0.5 * (y0 - y2) / (y0 - 2 * y1 + y2)
+    return s - n if s > n / 2 else s
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(-20, 20), st.floats(-0.45, 0.45), st.integers(0, 2**31))
+def test_drift_lines_matches_the_direct_correlation(shift, frac, seed):
+    # a smooth random texture and a copy moved by shift + frac lines (Fourier shift). The float32 FFTs
+    # perturb the correlation by ~1e-6 of its peak; the parabolic offset then moves by ~1e-6 / curvature
+    # (~0.1 of the peak here): 1e-4 lines leaves a margin of ~10
+    rng = np.random.default_rng(seed)
+    n, m = 128, 6
+    spec = (rng.standard_normal((n, m)) + 1j * rng.standard_normal((n, m))) * np.exp(
+        -0.5 * (np.fft.fftfreq(n)[:, None] / 0.06) ** 2)
+    f = np.fft.fftfreq(n)[:, None]
+    i1 = (np.abs(np.fft.ifft(spec, axis=0)) ** 2).astype(np.float32)
+    i2 = (np.abs(np.fft.ifft(spec * np.exp(-2j * np.pi * f * (shift + frac)), axis=0)) ** 2).astype(np.float32)
+    want = _drift_lines_numpy(i1.astype(np.float64), i2.astype(np.float64))
+    assert _drift_lines(i1, i2) == pytest.approx(want, abs=1e-4)
+    assert want == pytest.approx(shift + frac, abs=0.2)  # the reference itself finds the shift
