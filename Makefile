@@ -60,6 +60,10 @@ warm-cache:
 	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
 	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5 \
 	  --geotiff $(WARM)/slc.tif --quicklook $(WARM)/slc.png
+	@# the phase-only line correction (real data with a Doppler model varying across the block; no small
+	@# sample takes that path): a view of a block buffer, as rda.RDFocuser.focus_block passes it
+	$(BIN)/python -c "import numpy as np; from sarcli.focus.rda import apply_line_phase as f; \
+	  f(np.zeros((4, 9), np.complex64)[:, :8], 0, np.array([0, 4]), np.array([0, 7]), np.zeros((2, 2)))"
 	$(BIN)/sarcli -q gbsar simulate samples/gbsar_indoor.toml -o $(WARM)/scan.h5
 	for a in auto df rd bp; do $(BIN)/sarcli -q gbsar focus $(WARM)/scan.h5 --algorithm $$a -o $(WARM)/$$a.h5 || exit 1; done
 	@rm -rf $(WARM)
