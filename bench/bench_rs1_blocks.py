@@ -104,8 +104,9 @@ def _overlap(offset: int, n: int) -> tuple[slice, slice]:
 def section_a(raws: dict) -> tuple[str, dict]:
     import scipy.io
 
-    from sarcli.doppler.agcsteps import detect_gain_steps, line_power_db
+    from sarcli.doppler.agcsteps import detect_gain_steps
     from sarcli.io import agc_table
+    from sarcli.io.linepower import line_power_db
 
     table = agc_table.read_agc_table(AGC)
     rows, out = [], {}

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sarcli.io.linepower import group_power, power_db
+
 
 @dataclass
 class GainSteps:
@@ -53,12 +55,6 @@ class GainSteps:
         for m, dg in zip(self.lines, self.db_groups, strict=True):
             prof[:, m:] += dg[:, None]
         return prof
-
-
-def line_power_db(echo: np.ndarray) -> np.ndarray:
-    """10 log10 of the mean power of each line (float64)."""
-    p = np.mean(np.abs(np.asarray(echo, np.complex64)) ** 2, axis=1, dtype=np.float64)
-    return 10.0 * np.log10(np.maximum(p, 1e-30))
 
 
 def step_statistic(p: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +92,13 @@ def detect_gain_steps(echo: np.ndarray, w: int = 16, min_step_db: float = 0.25, 
     """Gain steps of ``echo`` (module docstring). Detection uses +-``w`` lines (none in an echo shorter
     than 2 w lines); each accepted step's size is then fitted over up to ``size_lines`` lines on either
     side, bounded by its neighbouring steps."""
-    p = line_power_db(echo)
+    n_s = echo.shape[1]
+    g0 = np.arange(0, n_s, max(1, group_samples), dtype=np.int64)
+    if g0.size > 1 and n_s - g0[-1] < group_samples // 2:
+        g0 = g0[:-1]  # a short last group joins the previous one
+    edges = np.append(g0, n_s)
+    group_p = group_power(echo, edges)  # one pass for the whole-line and the per-group powers
+    p = power_db(group_p @ np.diff(edges).astype(np.float64) / n_s)
     if p.size < 2 * w:
         return GainSteps(np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 1)), np.zeros(1, np.int64))
     d, sd = step_statistic(p, w)
@@ -115,14 +117,9 @@ def detect_gain_steps(echo: np.ndarray, w: int = 16, min_step_db: float = 0.25, 
     lines = np.array(sorted(set(lines)), dtype=np.int64)
     bounds = np.r_[0, lines, p.size]
     spans = [(max(bounds[i], m - size_lines), min(bounds[i + 2], m + size_lines)) for i, m in enumerate(lines)]
-    n_s = echo.shape[1]
-    g0 = np.arange(0, n_s, max(1, group_samples), dtype=np.int64)
-    if g0.size > 1 and n_s - g0[-1] < group_samples // 2:
-        g0 = g0[:-1]  # a short last group joins the previous one
-    edges = np.append(g0, n_s)
     dg = np.zeros((lines.size, g0.size))
     for j in range(g0.size):
-        pg = line_power_db(echo[:, edges[j]:edges[j + 1]])
+        pg = power_db(group_p[:, j])
         dg[:, j] = [step_size(pg, m, lo, hi) for m, (lo, hi) in zip(lines, spans, strict=True)]
     db = np.array([step_size(p, m, lo, hi) for m, (lo, hi) in zip(lines, spans, strict=True)])
     return GainSteps(lines, db, dg, g0)

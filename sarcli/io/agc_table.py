@@ -49,6 +49,7 @@ import numpy as np
 import scipy.io
 
 from sarcli.errors import FormatError
+from sarcli.io.linepower import line_power_db
 
 Z_MATCH = 8.0
 SEPARATION = 2.0
@@ -80,12 +81,6 @@ def read_agc_table(path: str | os.PathLike, variable: str | None = None) -> np.n
     if not np.all(np.isfinite(a)):
         raise FormatError(f"{path}: AGC variable '{name}' contains NaN or inf")
     return a
-
-
-def line_power_db(echo: np.ndarray) -> np.ndarray:
-    """10 log10 of the mean power of each line (float64; a zero line gives -300 dB)."""
-    p = np.mean(np.abs(np.asarray(echo, np.complex64)) ** 2, axis=1, dtype=np.float64)
-    return 10.0 * np.log10(np.maximum(p, 1e-30))
 
 
 @dataclass(frozen=True)

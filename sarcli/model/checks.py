@@ -90,11 +90,25 @@ def array(where: str, name: str, value: Any, kind: str = "f", ndim: int | None =
             raise ProductError(f"{where}: {name} has shape {a.shape}, expected {want}")
     if a.size < min_size:
         raise ProductError(f"{where}: {name} has {a.size} value(s), at least {min_size} needed")
-    if finite and a.dtype.kind in "fc" and a.size:
-        bad = ~np.isfinite(a.view(np.float32) if a.dtype == np.complex64 else a)
-        if bad.any():
-            raise ProductError(f"{where}: {name} contains NaN or inf ({int(bad.sum())} value(s))")
+    if finite and a.dtype.kind in "fc" and a.size and not _all_finite(a):
+        raise ProductError(f"{where}: {name} contains NaN or inf ({int(np.sum(~np.isfinite(a)))} value(s))")
     return a
+
+
+#: elements per slice of :func:`_all_finite` (8 MB of float32 flags at most)
+FINITE_SLICE = 1 << 21
+
+
+def _all_finite(a: np.ndarray, slice_elements: int = FINITE_SLICE) -> bool:
+    """Whether every value of the float or complex ``a`` is finite, tested in slices of about
+    ``slice_elements`` along the first axis (a full scene's echo would otherwise need a flag array of
+    290 MB, written page by page: 2-4x slower)."""
+    if a.dtype == np.complex64 and a.ndim and a.strides[-1] == a.itemsize:
+        a = a.view(np.float32)  # the float32 test is vectorized, the complex one is not (3x)
+    if a.ndim < 2:
+        return bool(np.isfinite(a).all())
+    rows = max(1, slice_elements // max(1, a[0].size))
+    return all(bool(np.isfinite(a[i:i + rows]).all()) for i in range(0, a.shape[0], rows))
 
 
 def increasing(where: str, name: str, a: np.ndarray, strict: bool = True) -> np.ndarray:

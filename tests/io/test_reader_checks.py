@@ -8,6 +8,8 @@ import dataclasses
 import h5py
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from orbit.frames import eci_to_ecef
 from sarcli.errors import ProductError
@@ -391,3 +393,17 @@ def test_probe_runs_once_per_file_version(tmp_path, monkeypatch):
     write_scan(tmp_path / "own.h5", _scan())  # what this process wrote needs no probe
     read_scan(tmp_path / "own.h5")
     assert len(asked) == 2
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.sampled_from([np.float32, np.float64, np.complex64, np.complex128]), st.integers(1, 3),
+       st.integers(0, 2**31), st.booleans(), st.booleans())
+def test_finite_check_in_slices_finds_every_bad_value(dtype, ndim, seed, strided, poison):
+    # slices of 7 elements: the bad value may sit in any slice, also the last (short) one
+    rng = np.random.default_rng(seed)
+    a = rng.standard_normal(tuple(rng.integers(1, 9, ndim))).astype(dtype)
+    if strided and a.shape[-1] > 1:
+        a = a[..., ::2]
+    if poison:
+        a[np.unravel_index(rng.integers(a.size), a.shape)] = np.nan if rng.integers(2) else np.inf
+    assert ck._all_finite(a, 7) == bool(np.isfinite(a).all()) == (not poison)
