@@ -86,21 +86,25 @@ def check_raw(raw: RawProduct) -> None:
                            "(ingest CEOS gaps with --missing zero or repeat)")
 
 
-def prepare(raw: RawProduct, gain_steps: str) -> tuple[RawProduct, GainSteps | None]:
+def prepare(raw: RawProduct, gain_steps: str, consume: bool = False) -> tuple[RawProduct, GainSteps | None]:
     """The product checked (:func:`check_raw`), with the per-line AGC undone and, per ``gain_steps``
     (auto: quantized products without an AGC record | on | off), the receiver-gain steps recovered
     from the echo undone; returns it with the steps found (None: not searched). The input is not
-    modified (copies)."""
+    modified (copies) unless ``consume``: then the caller gives up ``raw.echo`` and the steps are
+    undone in it (no copy of the echo)."""
     check_raw(raw)
     # the AGC changes line by line as bright targets cross the beam: left in, it re-weights the azimuth
     # spectrum asymmetrically (20 Hz on samples/rs1_point.toml)
     has_agc = raw.agc_db is not None
-    raw = raw.calibrated()
+    calibrated = raw.calibrated()
+    own = calibrated.echo is not raw.echo or consume  # an echo no one else holds may be changed
     steps = None
     if gain_steps == "on" or (gain_steps == "auto" and not has_agc and raw.radar.quantization_bits > 0):
         from sarcli.doppler.agcsteps import detect_gain_steps, undo_gain_steps
 
-        steps = detect_gain_steps(raw.echo)
+        steps = detect_gain_steps(calibrated.echo)
         if steps.lines.size:
-            raw = dataclasses.replace(raw, echo=undo_gain_steps(raw.echo, steps))
-    return raw, steps
+            echo = calibrated.echo
+            in_place = own and echo.dtype == np.complex64 and echo.flags.writeable
+            calibrated = dataclasses.replace(calibrated, echo=undo_gain_steps(echo, steps, in_place=in_place))
+    return calibrated, steps

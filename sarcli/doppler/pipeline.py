@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -51,6 +53,7 @@ from sarcli.model.doppler_summary import (
 from sarcli.model.poly import Poly2D
 from sarcli.model.raw import RawProduct
 from sarcli.model.terrain import Terrain
+from sarcli.threads import budget, limited
 
 #: ``progress(stage, done, total)`` after each of the :data:`STAGES`
 Progress = Callable[[str, int, int], None]
@@ -346,6 +349,22 @@ def doppler_rate(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, f
     return RateStage(fr_poly, np.asarray(fr_blk, float), fr_seed, look_seed, rho_seed, method, diag, grid_rel)
 
 
+def _each_on_a_core(fn: Callable[[Any], Any], jobs: list) -> list:
+    """``[fn(job) for job in jobs]``, the jobs side by side on the thread budget (one thread each: their
+    FFTs single-threaded, so numpy's single-threaded arithmetic between them runs on every core too).
+    Each job's result does not depend on the thread it ran on (a 1-D FFT is computed alike on any)."""
+    n = min(budget(), len(jobs))
+    if n <= 1:
+        return [fn(job) for job in jobs]
+
+    def one(job: Any) -> Any:
+        with limited(1):
+            return fn(job)
+
+    with ThreadPoolExecutor(n) as pool:
+        return list(pool.map(one, jobs))
+
+
 def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: SceneGeometry | None,
               Rg: np.ndarray, T: np.ndarray) -> tuple[Poly2D, np.ndarray, MapDriftFit]:
     """Map-drift rate per range segment over the central ``max_lines`` lines, and ONE effective velocity
@@ -362,7 +381,7 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
     free slope (fr R linear in R) fitted to a few noisy segments of a narrow swath had the wrong sign on
     the Vancouver block, and a 1/R law cannot be held flat physically.
     """
-    from sarcli.doppler.mapdrift import map_drift
+    from sarcli.doppler.mapdrift import MapDriftResult, map_drift
     from sarcli.doppler.rangecomp import range_compress_valid
 
     radar = raw.radar
@@ -372,7 +391,7 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
     dr = C / (2.0 * radar.range_sampling_rate_hz)
     t_c = float(np.mean(raw.azimuth_time[a0:a0 + rc.shape[0]]))
     edges = np.linspace(0, rc.shape[1], max(1, options.mapdrift_segments) + 1).astype(int)
-    rng, frs, wts, segments = [], [], [], []
+    jobs = []  # (samples a:b, segment range, starting rate)
     for a, b in zip(edges[:-1], edges[1:], strict=True):
         if b - a < 8:
             continue
@@ -383,7 +402,14 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
         else:
             v = radar.platform_velocity_mps or options.velocity_guess_mps
             fr0 = -2.0 * v**2 / (lam * r_seg)
-        res = map_drift(rc[:, a:b], radar.prf_hz, lam, r_seg, dr, fdc, fr0)
+        jobs.append((a, b, r_seg, fdc, fr0))
+
+    def drift(job: tuple[int, int, float, float, float]) -> MapDriftResult:
+        a, b, r_seg, fdc, fr0 = job
+        return map_drift(rc[:, a:b], radar.prf_hz, lam, r_seg, dr, fdc, fr0)
+
+    rng, frs, wts, segments = [], [], [], []
+    for (a, b, r_seg, _, fr0), res in zip(jobs, _each_on_a_core(drift, jobs), strict=True):
         ok = res.converged and res.fr_hz_per_s < 0 and abs(res.fr_hz_per_s / fr0 - 1.0) < 0.3
         segments.append((r_seg, res.fr_hz_per_s, fr0, res.iterations, res.converged, bool(ok)))
         if ok:  # a segment without focusable content (noise, dark sea) does not converge: dropped

@@ -110,7 +110,8 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         terrain = load_terrain(config.height_m, config.dem, config.dem_geoid)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            model = estimate_doppler(raw, config.options, terrain=terrain, progress=progress)
+            # the echo is read for the estimate alone: consumed (the plot below only reads the metadata)
+            model = estimate_doppler(raw, config.options, terrain=terrain, progress=progress, consume=True)
         assert model.summary is not None  # estimate_doppler always returns one
         if config.output is not None:
             from sarcli.io.doppler_product import write_doppler

@@ -114,3 +114,43 @@ def test_step_statistic_matches_a_least_squares_fit_per_line():
         assert d[m] == pytest.approx(coef[2], abs=1e-12)
         assert sd[m] == pytest.approx(np.sqrt(cov[2, 2]), rel=1e-9)
     assert np.all(d[:w] == 0) and np.all(np.isinf(sd[-w + 1:]))
+
+
+def test_undo_in_place_changes_the_echo_itself_to_the_same_values():
+    e = _stepped(gain=3.0)
+    s = detect_gain_steps(e)
+    copy = undo_gain_steps(e, s)
+    work = e.copy()
+    same = undo_gain_steps(work, s, in_place=True)
+    assert same is work and not np.array_equal(work, e)
+    np.testing.assert_array_equal(work, copy)
+    from sarcli.errors import SarcliError
+
+    with pytest.raises(SarcliError, match="in place"):
+        undo_gain_steps(e.astype(np.complex128), s, in_place=True)
+
+
+def test_a_consumed_echo_gives_the_same_estimate(clutter_raw):
+    """consume=True undoes the steps in the caller's echo (no copy); the model is identical, and without
+    it the caller's echo is left as it was."""
+    import dataclasses
+
+    from sarcli.doppler.api import estimate_doppler
+    from sarcli.doppler.options import DopplerOptions
+
+    g = np.zeros(clutter_raw.echo.shape[0])
+    g[clutter_raw.echo.shape[0] // 2:] = 4.0  # one 4 dB receiver-gain step half-way (the line power
+    # of this 384-sample scene jitters by 0.6 dB from line to line: 2 dB would not stand out)
+    stepped = (clutter_raw.echo * (10 ** (g / 20)).astype(np.float32)[:, None]).astype(np.complex64)
+    q = dataclasses.replace(clutter_raw, echo=stepped,
+                            radar=dataclasses.replace(clutter_raw.radar, quantization_bits=4))
+    opts = DopplerOptions(az_block=512, rg_block=96)
+    kept = q.echo.copy()
+    plain = estimate_doppler(q, opts)
+    assert len(plain.summary.gain_steps) == 1
+    np.testing.assert_array_equal(q.echo, kept)  # not consumed: untouched
+    consumed = estimate_doppler(q, opts, consume=True)
+    assert not np.array_equal(q.echo, kept)  # the step was undone in the echo itself
+    assert consumed.summary == plain.summary
+    np.testing.assert_array_equal(consumed.fdc_poly.coef, plain.fdc_poly.coef)
+    np.testing.assert_array_equal(consumed.fr_poly.coef, plain.fr_poly.coef)

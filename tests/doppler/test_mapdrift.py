@@ -18,6 +18,7 @@ from sarcli.errors import SarcliError
 from sarcli.io.doppler_product import read_doppler, write_doppler
 from sarcli.model.poly import Poly2D
 from sarcli.model.raw import Radar
+from sarcli.threads import limited
 from tests.doppler.conftest import SCENES, simulate_text
 from tests.doppler.synth import C, point_target_raw
 
@@ -80,6 +81,17 @@ def test_mapdrift_rate_follows_inverse_range_over_the_swath(airborne_raw, tmp_pa
     back = read_doppler(tmp_path / "d.h5")
     np.testing.assert_allclose(back.fr(far, 0.0), m.fr(far, 0.0), rtol=1e-14)
     assert back.summary.fr_info.mapdrift == md and back.summary == m.summary  # typed summary round trip
+
+
+def test_mapdrift_segments_side_by_side_give_the_serial_result(airborne_raw):
+    """The range segments run on a thread each (budget 3: a pool even on a smaller machine); the rates,
+    iterations and Vr are those of one thread, bit for bit."""
+    opts = DopplerOptions(velocity_guess_mps=2200.0, ambiguity_value=0)
+    with limited(1):
+        serial = estimate_doppler(airborne_raw, opts).summary.fr_info
+    with limited(3):
+        pooled = estimate_doppler(airborne_raw, opts).summary.fr_info
+    assert pooled == serial
 
 
 @settings(max_examples=40, deadline=None)
