@@ -54,3 +54,19 @@ def test_extended_keeps_the_valid_samples_and_never_wraps():
     # points cut by both edges at once: a circular wrap would put one onto the other's samples
     ref = np.convolve(x[0], np.conj(_chirp()[::-1])) / 61
     np.testing.assert_allclose(ext[0], ref[:N + 60], atol=4e-3)
+
+
+def test_compression_in_line_chunks_is_the_whole_array_compression(monkeypatch):
+    """The lines are compressed CHUNK_LINES at a time; each line's FFTs are the same whatever its chunk,
+    so chunks of 3 lines (the last one short) give the single-chunk result bit for bit."""
+    from sarcli.doppler import rangecomp
+
+    rng = np.random.default_rng(3)
+    x = (rng.standard_normal((11, N)) + 1j * rng.standard_normal((11, N))).astype(np.complex64)
+    calls = (lambda: rangecomp.range_compress_valid(x, RADAR), lambda: rangecomp.range_compress_extended(x, RADAR),
+             lambda: rangecomp.range_looks(x, RADAR))
+    whole = [c() for c in calls]
+    monkeypatch.setattr(rangecomp, "CHUNK_LINES", 3)
+    for c, w in zip(calls, whole, strict=True):
+        for a, b in zip(c(), w, strict=True):
+            assert a == b if isinstance(a, slice) else np.array_equal(a, b)
