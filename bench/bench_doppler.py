@@ -27,10 +27,18 @@ from pathlib import Path
 import numpy as np
 from numba import njit, prange
 
-from bench.common import RESULTS, best_time, first_call_time, markdown_table, peak_rss_bytes, write_results
+from bench.common import (
+    FULL_SCENE,
+    RESULTS,
+    SHARED,
+    best_time,
+    first_call_time,
+    markdown_table,
+    peak_rss_bytes,
+    tiled_real_block,
+    write_results,
+)
 from sarcli.io.h5common import to_jsonable
-
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 
 
 def _full_size_array(n_lines: int = 23000, n_samples: int = 6354, seed: int = 0) -> np.ndarray:
@@ -348,9 +356,6 @@ def section_real(out: dict) -> str:
               f"{s['scene_range_m'] / 1e3:.1f} km. estimate_doppler took {t_est:.1f} s.\n")
 
 
-#: a full Radarsat-1 fine-beam scene's size (lines, samples)
-FULL_SCENE = (23000, 6354)
-
 #: runs the CLI and prints its own peak RSS (VmHWM, sarcli.memory) on stderr at exit
 _CLI_WITH_PEAK = ("import atexit, sys; from sarcli.memory import peak_rss_bytes; "
                   "atexit.register(lambda: sys.stderr.write(f'peak_rss_bytes {peak_rss_bytes()}\\n')); "
@@ -363,22 +368,12 @@ def section_full_scene(out: dict) -> str:
     import sys
     import tempfile
 
-    mat, par = SHARED / "rs1_vancouver_block1.mat", SHARED / "rs1_vancouver_run_params.mat"
-    if not mat.exists():
+    if not (SHARED / "rs1_vancouver_block1.mat").exists():
         return "## H. Full scene\n\n../shared/data not available in this run.\n"
-    from sarcli.io.matlab import read_matlab_block
-    from sarcli.io.raw import write_raw
-
-    raw = read_matlab_block(mat, par)
     n, m = FULL_SCENE
-    reps = (-(-n // raw.echo.shape[0]), -(-m // raw.echo.shape[1]))
-    echo = np.ascontiguousarray(np.tile(raw.echo, reps)[:n, :m], np.complex64)
     with tempfile.TemporaryDirectory() as td:
         path = Path(td) / "tiled.h5"
-        write_raw(path, dataclasses.replace(raw, echo=echo, azimuth_time=raw.azimuth_time[0]
-                                            + np.arange(n) / raw.radar.prf_hz))
-        gb = echo.nbytes / 2**30
-        del echo
+        gb = tiled_real_block(path)
         walls, peaks = [], []
         load = os.getloadavg()[0]
         for _ in range(2):

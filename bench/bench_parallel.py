@@ -30,10 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.common import RESULTS, markdown_table, peak_rss_bytes, write_results
+from bench.common import RESULTS, SARCLI, markdown_table, peak_rss_bytes, write_results
 
 REPO = Path(__file__).resolve().parents[1]
-SARCLI = str(Path(sys.executable).parent / "sarcli")
 ROUNDS = int(os.environ.get("ROUNDS", "2"))
 BIG = (23000, 6354)
 FDC, FR = "-6690", "-1990"

@@ -1,5 +1,6 @@
 """Product storage: sizes and costs of the raw echo's HDF5 compression, echo chunking for line-block
-reads, SLC compression, and the Cloud-Optimized GeoTIFF writer against a plain tiled GeoTIFF.
+reads, SLC compression, the Cloud-Optimized GeoTIFF writer against a plain tiled GeoTIFF, and the GeoTIFF
+compressions on a full scene's map.
 
 Data: the real RADARSAT-1 Vancouver raw block (``../shared/data/rs1_vancouver_block1.mat``, 1536 lines x
 2048 samples of 4-bit levels, read by sarcli's MATLAB reader), a float echo of complex Gaussian noise of
@@ -22,10 +23,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from bench.common import best_time, markdown_table, write_results
+from bench.common import SARCLI, SHARED, best_time, markdown_table, tiled_real_block, write_results
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 BLOCK = 64
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _rs1():
@@ -151,6 +152,58 @@ def geotiff_rows(folder: Path) -> list[dict]:
     return rows
 
 
+#: the Vancouver block's Doppler (docs/doppler.md, section F), for focusing its tiled full scene
+VANCOUVER_FDC_FR = ("-6900", "-1733")
+
+
+def full_scene_map_rows(folder: Path) -> tuple[list[dict], dict]:
+    """The map GeoTIFF of a full scene (the real block tiled to 23000 x 6354 on the orbit of
+    samples/rs1_point.toml, focused by ``sarcli focus --geotiff --geotiff-compression none``), copied by
+    GDAL's COG driver with each compression as write_geotiff does (its levels kept): the copy's time, the
+    fsync that makes it durable, and the file size."""
+    import json
+    import os
+    import subprocess
+
+    import rasterio
+    import rasterio.shutil
+
+    from sarcli import threads
+    from sarcli.io.images import BLOCK as TILE
+    from sarcli.io.images import COMPRESSIONS
+
+    raw, sample = folder / "full.h5", folder / "sample.h5"
+    subprocess.run([SARCLI, "-q", "simulate", str(REPO / "samples" / "rs1_point.toml"), "-o", str(sample)], check=True)
+    gib = tiled_real_block(raw, orbit_of=sample)
+    first = folder / "map_none.tif"
+    fdc, fr = VANCOUVER_FDC_FR
+    report = json.loads(subprocess.run(
+        [SARCLI, "-q", "focus", str(raw), "-o", str(folder / "full_slc.h5"), "--fdc", fdc, "--fr", fr, "--geotiff",
+         str(first), "--geotiff-compression", "none", "--json"], check=True, capture_output=True, text=True).stdout)
+    raw.unlink()
+    (folder / "full_slc.h5").unlink()
+    with rasterio.open(first) as d:
+        shape = [d.height, d.width]
+        nan = float(np.mean(np.isnan(d.read(1, out_shape=(d.height // 8, d.width // 8)))))
+    rows = []
+    for name, codec in COMPRESSIONS.items():
+        path = folder / f"map_{name}.tif"
+        t0 = time.perf_counter()
+        rasterio.shutil.copy(str(first), str(path), driver="COG", **codec, BLOCKSIZE=str(TILE),
+                             OVERVIEWS="FORCE_USE_EXISTING", BIGTIFF="IF_SAFER", NUM_THREADS=str(threads.budget()))
+        t1 = time.perf_counter()
+        fd = os.open(path, os.O_RDONLY)
+        os.fsync(fd)
+        os.close(fd)
+        t2 = time.perf_counter()
+        rows.append({"compression": name, "copy_s": t1 - t0, "fsync_s": t2 - t1, "total_s": t2 - t0,
+                     "MB": path.stat().st_size / 1e6})
+        path.unlink()
+    info = {"echo_gib": gib, "map_shape": shape, "nan_fraction": nan, "focus_total_s": report["timings_s"]["total_s"],
+            "products_s": report["timings_s"]["statistics_and_products_s"]}
+    return rows, info
+
+
 def main() -> None:
     if not (SHARED / "rs1_vancouver_block1.mat").is_file():
         raise SystemExit(f"bench_products needs {SHARED / 'rs1_vancouver_block1.mat'} (../shared/data)")
@@ -161,6 +214,7 @@ def main() -> None:
         raw = raw_rows("RS-1 4-bit block", rs1, folder) + raw_rows("float noise echo", _float_twin(rs1), folder)
         slc = slc_rows(folder)
         tif = geotiff_rows(folder)
+        full, full_info = full_scene_map_rows(folder)
     md = ["# bench_products: product storage\n",
           f"Raw echo: {rs1.echo.shape[0]} x {rs1.echo.shape[1]} complex64 "
           f"({rs1.echo.nbytes / 1e6:.1f} MB in memory); read blocks = {BLOCK}-line blocks over the file.\n",
@@ -174,8 +228,19 @@ def main() -> None:
                          [[r["compression"], r["MB"], r["ratio"], r["write_s"], r["read_s"]] for r in slc]),
           "\nGeoTIFF, 2 bands float32 2048 x 2048 (amplitude and dB of speckle):\n",
           markdown_table(["writer", "write s", "MB"], [[r["writer"], r["write_s"], r["MB"]] for r in tif]),
+          f"\nMap GeoTIFF of a full scene (the real block tiled to 23000 x 6354, {full_info['echo_gib']:.2f} GiB of "
+          f"echo, on the orbit of samples/rs1_point.toml; map {full_info['map_shape'][0]} x "
+          f"{full_info['map_shape'][1]}, 2 bands float32, {100 * full_info['nan_fraction']:.0f} % no-data corners): "
+          "GDAL's COG copy with each compression (what write_geotiff runs last, overviews kept) and the fsync "
+          f"that makes the file durable; one run each. The whole `sarcli focus --geotiff` took "
+          f"{full_info['focus_total_s']:.1f} s, its statistics and products {full_info['products_s']:.1f} s "
+          "(uncompressed).\n",
+          markdown_table(["compression", "COG copy s", "fsync s", "total s", "x deflate", "MB", "x deflate size"],
+                         [[r["compression"], r["copy_s"], r["fsync_s"], r["total_s"], r["total_s"] / full[0]["total_s"],
+                           r["MB"], r["MB"] / full[0]["MB"]] for r in full]),
           f"\nTotal {time.perf_counter() - t0:.0f} s.\n"]
-    write_results("bench_products", "\n".join(md), {"raw": raw, "slc": slc, "geotiff": tif})
+    write_results("bench_products", "\n".join(md), {"raw": raw, "slc": slc, "geotiff": tif,
+                                                     "full_scene_map": {"rows": full, **full_info}})
 
 
 if __name__ == "__main__":

@@ -26,14 +26,12 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench.common import markdown_table, write_results
+from bench.common import SARCLI, SHARED, markdown_table, write_results
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = REPO.parent / "shared" / "data"
 #: the imports every processing command needs: no such command starts faster than this process
 _FLOOR = "imports only (numpy, scipy.fft, h5py, numba, typer)"
 BIN = Path(sys.executable).parent
-SARCLI = str(BIN / "sarcli")
 
 
 def _run(cmd: list[str], env: dict | None = None) -> tuple[float, float]:

@@ -188,11 +188,11 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
                         terrain: Terrain | None = None, inputs: tuple = (),
-                        intensity: np.ndarray | None = None) -> None:
+                        intensity: np.ndarray | None = None, compression: str = "deflate") -> None:
     """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m);
     ``tags``: extra tags beside :func:`slc_tags`; ``inputs``: the files it was made from (the SLC).
     ``intensity``: ``multilook(slc.image, looks_az, looks_rg)`` when the caller has it (then ``slc``
-    needs no image)."""
+    needs no image); ``compression``: ``sarcli.io.images.COMPRESSIONS``."""
     from sarcli.io.images import Strips, write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
@@ -207,7 +207,8 @@ def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ta
 
     bands, style = _amplitude_bands(Strips(inten.shape, strips), inten, full,
                                     "slant-range geometry (lines: zero-Doppler time)")
-    write_geotiff(path, bands, 4326, gcps=gcps, tags=slc_tags(slc, inputs, tags), style=style)
+    write_geotiff(path, bands, 4326, gcps=gcps, tags=slc_tags(slc, inputs, tags), style=style,
+                  compression=compression)
 
 
 def map_project(slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
@@ -569,14 +570,15 @@ def amplitude_numpy(inten: np.ndarray, full: np.ndarray, r: np.ndarray, c: np.nd
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
                       spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None,
-                      inputs: tuple = (), intensity: np.ndarray | None = None) -> str:
+                      inputs: tuple = (), intensity: np.ndarray | None = None, compression: str = "deflate") -> str:
     """Map-projected amplitude COG (NaN nodata; module docstring); returns the CRS used.
-    ``intensity``: as in :func:`write_slant_geotiff`."""
+    ``intensity`` and ``compression``: as in :func:`write_slant_geotiff`."""
     from sarcli.io.images import write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     amp, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, intensity=inten)
     bands, style = _amplitude_bands(amp, inten, full_rows(slc, inten.shape[0], looks_az),
                                     "map projected (bilinear intensity resampling)")
-    write_geotiff(path, bands, crs, transform=transform, tags=slc_tags(slc, inputs, tags), style=style)
+    write_geotiff(path, bands, crs, transform=transform, tags=slc_tags(slc, inputs, tags), style=style,
+                  compression=compression)
     return crs

@@ -49,7 +49,8 @@ class Config:
     (:data:`sarcli.focus.FOCUSERS`); options: the focuser's options (its ``Options`` fields);
     height_m / dem / dem_geoid: the terrain (:func:`sarcli.io.dem.load_terrain`); geotiff (map
     projected, ``crs`` default UTM, ``pixel_spacing_m``), geotiff_slant, quicklook: optional products
-    with looks_az x looks_rg looks; channel: receive channel (0 = /echo);
+    with looks_az x looks_rg looks, the GeoTIFFs' tiles compressed by ``geotiff_compression``
+    (``sarcli.io.images.COMPRESSIONS``); channel: receive channel (0 = /echo);
     accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved;
     workers / threads_per_worker / scheduler: focus the blocks in parallel on a local Dask cluster of
     that many processes, or on the scheduler at that address (:mod:`sarcli.parallel.cluster`); they
@@ -68,6 +69,7 @@ class Config:
     dem_geoid: Literal["egm96", "egm2008"] | None = None
     geotiff: Path | None = None
     geotiff_slant: Path | None = None
+    geotiff_compression: Literal["deflate", "zstd", "none"] = "deflate"
     quicklook: Path | None = None
     crs: str | None = None
     pixel_spacing_m: float | None = None
@@ -95,6 +97,9 @@ class Config:
                 raise ConfigError(f"--{name.replace('_m', '')} must be a finite number, got {v}")
         if self.channel < 0:
             raise ConfigError(f"--channel must be >= 0, got {self.channel}")
+        from sarcli.io.images import compression_options
+
+        compression_options(self.geotiff_compression)  # one line naming the choices if unknown
         if self.crs is not None:
             from pyproj import CRS
             from pyproj.exceptions import CRSError
@@ -352,14 +357,16 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
         from sarcli.focus.geocode import write_slant_geotiff
 
         write_slant_geotiff(config.geotiff_slant, slc, config.looks_az, config.looks_rg, tags, terrain,
-                            inputs=(config.output,), intensity=sink.intensity(config.looks_az, config.looks_rg))
+                            inputs=(config.output,), intensity=sink.intensity(config.looks_az, config.looks_rg),
+                            compression=config.geotiff_compression)
         products["geotiff_slant"] = str(config.geotiff_slant)
     if config.geotiff:
         from sarcli.focus.geocode import write_map_geotiff
 
         used = write_map_geotiff(config.geotiff, slc, config.looks_az, config.looks_rg, config.crs,
                                  config.pixel_spacing_m, tags, terrain, inputs=(config.output,),
-                                 intensity=sink.intensity(config.looks_az, config.looks_rg))
+                                 intensity=sink.intensity(config.looks_az, config.looks_rg),
+                                 compression=config.geotiff_compression)
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
     if config.quicklook:

@@ -196,3 +196,48 @@ def test_the_file_does_not_depend_on_the_thread_budget(tmp_path):
             write_geotiff(tmp_path / f"t{n}.tif", [Band(a, "a", "1", "power")], "EPSG:32610", transform=t,
                           tags={"k": "v"})
     assert (tmp_path / "t1.tif").read_bytes() == (tmp_path / "t2.tif").read_bytes()
+
+
+@pytest.mark.parametrize("compression,tag", [("deflate", "deflate"), ("zstd", "zstd"), ("none", None)])
+def test_every_compression_gives_a_valid_cog_of_the_same_pixels(tmp_path, compression, tag):
+    """The COG driver compresses the tiles as asked; the pixels, overviews and layout stay the same."""
+    rng = np.random.default_rng(4)
+    amp = np.abs(rng.standard_normal((530, 610))).astype(np.float32)
+    amp[:90, :120] = np.nan  # a no-data corner, as a map's
+    t = Affine(10.0, 0.0, 500000.0, 0.0, -10.0, 5400000.0)
+    path = tmp_path / f"{compression}.tif"
+    write_geotiff(path, [Band(amp, "a", "1", "power")], "EPSG:32610", transform=t, compression=compression)
+    assert cog_validate(str(path)) == (True, [], [])
+    with rasterio.open(path) as ds:
+        assert ds.profile.get("compress") == tag
+        np.testing.assert_array_equal(ds.read(1), amp)
+        assert ds.overviews(1) == [2, 4]
+        with rasterio.open(path, overview_level=0) as ov:
+            first = ov.read(1)
+    write_geotiff(tmp_path / "ref.tif", [Band(amp, "a", "1", "power")], "EPSG:32610", transform=t)
+    with rasterio.open(tmp_path / "ref.tif", overview_level=0) as ov:
+        np.testing.assert_array_equal(first, ov.read(1))
+
+
+def test_an_unknown_compression_is_refused_in_one_line(tmp_path):
+    from sarcli.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="deflate, zstd, none"):
+        write_geotiff(tmp_path / "x.tif", [Band(np.ones((4, 4), np.float32), "a", "1", "power")], "EPSG:32610",
+                      transform=Affine(1.0, 0.0, 0.0, 0.0, -1.0, 0.0), compression="lzw")
+    assert not (tmp_path / "x.tif").exists()
+
+
+def test_focus_geotiff_compression_option(small, tmp_path):
+    from tests.conftest import run_cli
+
+    r = run_cli("focus", small.raw, "-o", tmp_path / "slc.h5", "--range-window", "rect", "--looks-az", "2",
+                "--geotiff", tmp_path / "z.tif", "--geotiff-compression", "zstd")
+    assert r.exit_code == 0, r.stderr
+    with rasterio.open(tmp_path / "z.tif") as z, rasterio.open(small.map_tif) as d:
+        assert (z.profile["compress"], d.profile["compress"]) == ("zstd", "deflate")
+        np.testing.assert_array_equal(z.read(), d.read())  # the same pixels as the default's
+    r = run_cli("focus", small.raw, "-o", tmp_path / "slc2.h5", "--geotiff", tmp_path / "x.tif",
+                "--geotiff-compression", "lzw")
+    assert r.exit_code == 2 and "GeoTIFF compression must be one of deflate, zstd, none" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "slc2.h5").exists()
