@@ -12,7 +12,8 @@ Sections (all measured in one run, same machine):
      data-only ambiguity + confidence, map-drift rate).
   G. The README examples: samples/rs1_clutter.toml (2048 lines, 4-bit AGC) and the 512-line test scene,
      scene-centre and RMS centroid error against the truth.
-  H. A full scene: ``sarcli doppler`` on the Vancouver block tiled to 23000 x 6354, wall time and the
+  H. Scene contrast: CDE vs look balance on a simulated coast (tests/doppler/scenes/rs1_coast.toml).
+  I. A full scene: ``sarcli doppler`` on the Vancouver block tiled to 23000 x 6354, wall time and the
      command's own peak RSS.
 Run: ``.venv/bin/python -m bench.bench_doppler`` (writes bench/results/bench_doppler.md|json|png).
 """
@@ -369,7 +370,7 @@ def section_full_scene(out: dict) -> str:
     import tempfile
 
     if not (SHARED / "rs1_vancouver_block1.mat").exists():
-        return "## H. Full scene\n\n../shared/data not available in this run.\n"
+        return "## I. Full scene\n\n../shared/data not available in this run.\n"
     n, m = FULL_SCENE
     with tempfile.TemporaryDirectory() as td:
         path = Path(td) / "tiled.h5"
@@ -385,7 +386,7 @@ def section_full_scene(out: dict) -> str:
             (Path(td) / "d.h5").unlink()
     out["full_scene"] = {"shape": [n, m], "echo_gib": gb, "wall_s": walls, "peak_rss_gib": peaks,
                          "load_average": load}
-    return ("## H. Full scene: `sarcli doppler` on 23000 x 6354\n\n"
+    return ("## I. Full scene: `sarcli doppler` on 23000 x 6354\n\n"
             f"The real Vancouver block tiled to 23000 x 6354 ({gb:.2f} GiB of echo; the tile seams are "
             "line-power jumps that the gain-step search finds and undoes). Best of 2 runs: "
             f"**{min(walls):.1f} s** wall, peak RSS **{min(peaks):.2f} GiB = {min(peaks) / gb:.2f} x the echo** "

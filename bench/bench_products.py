@@ -175,7 +175,7 @@ def full_scene_map_rows(folder: Path) -> tuple[list[dict], dict]:
     raw, sample = folder / "full.h5", folder / "sample.h5"
     subprocess.run([SARCLI, "-q", "simulate", str(REPO / "samples" / "rs1_point.toml"), "-o", str(sample)], check=True)
     gib = tiled_real_block(raw, orbit_of=sample)
-    first = folder / "map_none.tif"
+    first = folder / "map_focus.tif"
     fdc, fr = VANCOUVER_FDC_FR
     report = json.loads(subprocess.run(
         [SARCLI, "-q", "focus", str(raw), "-o", str(folder / "full_slc.h5"), "--fdc", fdc, "--fr", fr, "--geotiff",
