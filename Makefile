@@ -48,8 +48,9 @@ test-latest:
 ## warm-cache: byte-compile the package (an editable install has no .pyc until a run writes them, and none
 ##   is ever written where PYTHONDONTWRITEBYTECODE is set: 0.4 s of compiling per command), then compile the
 ##   numba kernels of the main commands into the per-user cache (sarcli/__init__.py) on small samples (CEOS
-##   ingest, Doppler, focus with its GeoTIFF and quicklook, GB-SAR focus), so that the first command after
-##   install loads them instead of compiling (run by install; make demo then compiles nothing)
+##   ingest, Doppler with the gain-step search, focus with its GeoTIFF and quicklook, GB-SAR focus), so
+##   that the first command after install loads them instead of compiling (run by install; make demo then
+##   compiles nothing)
 warm-cache:
 	@rm -rf $(WARM) && mkdir -p $(WARM)
 	$(BIN)/python -m compileall -q sarcli orbit
@@ -57,7 +58,7 @@ warm-cache:
 	$(BIN)/sarcli -q simulate samples/rs1_point.toml --format ceos -o $(WARM)/ceos
 	$(BIN)/sarcli -q ingest $(WARM)/ceos -o $(WARM)/ingested.h5
 	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 -o $(WARM)/doppler.h5
-	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift
+	$(BIN)/sarcli doppler -q $(WARM)/raw.h5 --ambiguity data --fr-method mapdrift --gain-steps on
 	$(BIN)/sarcli -q focus $(WARM)/raw.h5 --doppler $(WARM)/doppler.h5 -o $(WARM)/slc.h5 \
 	  --geotiff $(WARM)/slc.tif --quicklook $(WARM)/slc.png
 	@# the phase-only line correction (real data with a Doppler model varying across the block; no small

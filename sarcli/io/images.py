@@ -212,8 +212,8 @@ def write_geotiff(
     compression: str = "deflate",
 ) -> None:
     """Write a Cloud-Optimized GeoTIFF of float32 ``bands`` (nodata NaN) and its QGIS style (module
-    docstring). ``compression``: one of :data:`COMPRESSIONS` (deflate, readable everywhere; zstd,
-    about 2x faster to write at the same size, needs a reader with zstd: GDAL >= 2.3; none).
+    docstring). ``compression``: one of :data:`COMPRESSIONS` (deflate, the widest support; zstd, about
+    2x faster to compress at the same size, needs a reader with zstd: GDAL >= 2.3; none).
 
     Georeferencing is either an affine ``transform`` (rasterio.Affine) in ``crs``, or ground control
     points ``gcps`` given as (row, col, x, y, z) in ``crs`` (e.g. EPSG:4326 lon/lat for slant-range

@@ -65,8 +65,8 @@ def focus(
                                   "of ground range and azimuth)."),
     geotiff_compression: str = typer.Option(
         "deflate", "--geotiff-compression", metavar="[deflate|zstd|none]",
-        help="Tile compression of the GeoTIFFs: deflate (readable everywhere), zstd (about 2x faster to "
-             "write, same size; GDAL >= 2.3 reads it) or none (fastest, largest: NaN corners stored whole)."),
+        help="Tile compression of the GeoTIFFs: deflate (the widest support), zstd (about 2x faster to "
+             "compress, same size; GDAL >= 2.3 reads it) or none (twice the size: no-data corners stored whole)."),
     looks_az: int = typer.Option(1, "--looks-az", help="Azimuth looks for the GeoTIFFs/quicklook."),
     looks_rg: int = typer.Option(1, "--looks-rg", help="Range looks for the GeoTIFFs/quicklook."),
     quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the amplitude (dB)."),
