@@ -350,9 +350,24 @@ class _Echo:
 
 
 def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
-    """GeoTIFFs and quicklook from the multilooked intensities the sink accumulated (``slc``: metadata)."""
+    """GeoTIFFs and quicklook from the multilooked intensities the sink accumulated (``slc``: metadata).
+    The GeoTIFFs' provenance hashes the SLC just written (1.2 GB for a full scene, about 1 s): on a thread
+    while the quicklook is drawn, so the GeoTIFFs find it done (``sha256_file`` keeps it)."""
+    from sarcli.io.h5common import hashing
+
     products = {"slc": str(config.output)}
     tags = {"source_product": Path(config.output).name, "algorithm": config.algorithm, "doppler": how}
+    geotiffs = config.geotiff or config.geotiff_slant
+    with hashing([config.output] if geotiffs else []) as slc_hashed:
+        if config.quicklook:
+            from sarcli.focus.quicklook import quicklook_looks, write_slc_quicklook
+
+            la, lr, _ = quicklook_looks((slc.azimuth_time.size, slc.slant_range.size), config.looks_az,
+                                        config.looks_rg)
+            write_slc_quicklook(config.quicklook, slc, config.looks_az, config.looks_rg,
+                                intensity=sink.intensity(la, lr))
+            products["quicklook"] = str(config.quicklook)
+        slc_hashed()
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 
@@ -369,10 +384,4 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
                                  compression=config.geotiff_compression)
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
-    if config.quicklook:
-        from sarcli.focus.quicklook import quicklook_looks, write_slc_quicklook
-
-        la, lr, _ = quicklook_looks((slc.azimuth_time.size, slc.slant_range.size), config.looks_az, config.looks_rg)
-        write_slc_quicklook(config.quicklook, slc, config.looks_az, config.looks_rg, intensity=sink.intensity(la, lr))
-        products["quicklook"] = str(config.quicklook)
     return products

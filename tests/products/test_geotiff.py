@@ -241,3 +241,30 @@ def test_focus_geotiff_compression_option(small, tmp_path):
                 "--geotiff-compression", "lzw")
     assert r.exit_code == 2 and "GeoTIFF compression must be one of deflate, zstd, none" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "slc2.h5").exists()
+
+
+def test_the_slc_is_hashed_once_beside_the_quicklook(small, tmp_path, monkeypatch):
+    """The GeoTIFFs' INPUTS tag hashes the SLC just written: once, on the hashing thread while the
+    quicklook is drawn; both GeoTIFFs then find it in sha256_file's table."""
+    import os
+    import threading
+
+    from sarcli.io import h5common
+    from tests.conftest import run_cli
+
+    reads = []
+    real_open = open
+
+    def counting_open(path, mode="r", *a, **k):
+        if "b" in mode and "slc" in os.fspath(path):
+            reads.append(threading.current_thread().name)
+        return real_open(path, mode, *a, **k)
+
+    monkeypatch.setattr(h5common, "open", counting_open, raising=False)
+    r = run_cli("focus", small.raw, "-o", tmp_path / "slc.h5", "--range-window", "rect", "--looks-az", "2",
+                "--geotiff", tmp_path / "m.tif", "--geotiff-slant", tmp_path / "s.tif", "--quicklook",
+                tmp_path / "q.png")
+    assert r.exit_code == 0, r.stderr
+    assert len(reads) == 1 and reads[0].startswith("sarcli-sha256"), reads
+    with rasterio.open(tmp_path / "m.tif") as d:
+        assert json.loads(d.tags()["INPUTS"]) == [{"path": "slc.h5", "sha256": _sha(tmp_path / "slc.h5")}]
