@@ -16,7 +16,8 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
 
 _LIMIT: contextvars.ContextVar[int | None] = contextvars.ContextVar("sarcli_thread_budget", default=None)
 
@@ -61,3 +62,20 @@ def limited(n: int) -> Iterator[int]:
     finally:
         numba.set_num_threads(before)
         _LIMIT.reset(token)
+
+
+def one_thread_each(fn: Callable[[Any], Any], jobs: Sequence[Any]) -> list[Any]:
+    """``[fn(job) for job in jobs]``, the jobs side by side on the budget's threads, each under
+    ``limited(1)`` (its FFTs and kernels single-threaded, so the single-threaded numpy arithmetic between
+    them runs on every core too); in order. For jobs whose result does not depend on the thread count."""
+    n = min(budget(), len(jobs))
+    if n <= 1:
+        return [fn(job) for job in jobs]
+    from concurrent.futures import ThreadPoolExecutor
+
+    def one(job: Any) -> Any:
+        with limited(1):
+            return fn(job)
+
+    with ThreadPoolExecutor(n) as pool:
+        return list(pool.map(one, jobs))

@@ -31,7 +31,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sarcli.errors import SarcliError
 from sarcli.io.linepower import group_power, power_db
 
 
@@ -128,11 +127,10 @@ def detect_gain_steps(echo: np.ndarray, w: int = 16, min_step_db: float = 0.25, 
 
 def undo_gain_steps(echo: np.ndarray, steps: GainSteps, in_place: bool = False) -> np.ndarray:
     """The echo with each group's step profile divided out (the first segment keeps its level): a
-    complex64 copy, or with ``in_place`` the complex64 ``echo`` itself, changed (a full scene's echo is
-    1.1 GB: the copy doubled the Doppler estimate's memory)."""
-    if in_place and not (echo.dtype == np.complex64 and echo.flags.writeable):
-        raise SarcliError("gain steps can only be undone in place in a writable complex64 echo")
-    out = echo if in_place else np.array(echo, np.complex64)
+    complex64 copy, or with ``in_place`` the ``echo`` itself, changed, when it is a writable complex64
+    array (a full scene's echo is 1.1 GB: the copy doubled the Doppler estimate's memory)."""
+    reuse = in_place and echo.dtype == np.complex64 and echo.flags.writeable
+    out = echo if reuse else np.array(echo, np.complex64)
     if steps.lines.size == 0:
         return out
     prof = steps.profile_db(out.shape[0])

@@ -104,7 +104,5 @@ def prepare(raw: RawProduct, gain_steps: str, consume: bool = False) -> tuple[Ra
 
         steps = detect_gain_steps(calibrated.echo)
         if steps.lines.size:
-            echo = calibrated.echo
-            in_place = own and echo.dtype == np.complex64 and echo.flags.writeable
-            calibrated = dataclasses.replace(calibrated, echo=undo_gain_steps(echo, steps, in_place=in_place))
+            calibrated = dataclasses.replace(calibrated, echo=undo_gain_steps(calibrated.echo, steps, in_place=own))
     return calibrated, steps

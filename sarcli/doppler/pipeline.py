@@ -21,9 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -53,7 +51,7 @@ from sarcli.model.doppler_summary import (
 from sarcli.model.poly import Poly2D
 from sarcli.model.raw import RawProduct
 from sarcli.model.terrain import Terrain
-from sarcli.threads import budget, limited
+from sarcli.threads import one_thread_each
 
 #: ``progress(stage, done, total)`` after each of the :data:`STAGES`
 Progress = Callable[[str, int, int], None]
@@ -349,22 +347,6 @@ def doppler_rate(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, f
     return RateStage(fr_poly, np.asarray(fr_blk, float), fr_seed, look_seed, rho_seed, method, diag, grid_rel)
 
 
-def _each_on_a_core(fn: Callable[[Any], Any], jobs: list) -> list:
-    """``[fn(job) for job in jobs]``, the jobs side by side on the thread budget (one thread each: their
-    FFTs single-threaded, so numpy's single-threaded arithmetic between them runs on every core too).
-    Each job's result does not depend on the thread it ran on (a 1-D FFT is computed alike on any)."""
-    n = min(budget(), len(jobs))
-    if n <= 1:
-        return [fn(job) for job in jobs]
-
-    def one(job: Any) -> Any:
-        with limited(1):
-            return fn(job)
-
-    with ThreadPoolExecutor(n) as pool:
-        return list(pool.map(one, jobs))
-
-
 def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: SceneGeometry | None,
               Rg: np.ndarray, T: np.ndarray) -> tuple[Poly2D, np.ndarray, MapDriftFit]:
     """Map-drift rate per range segment over the central ``max_lines`` lines, and ONE effective velocity
@@ -409,7 +391,8 @@ def _mapdrift(raw: RawProduct, options: DopplerOptions, fdc_poly: Poly2D, geo: S
         return map_drift(rc[:, a:b], radar.prf_hz, lam, r_seg, dr, fdc, fr0)
 
     rng, frs, wts, segments = [], [], [], []
-    for (a, b, r_seg, _, fr0), res in zip(jobs, _each_on_a_core(drift, jobs), strict=True):
+    # one thread per segment: a 1-D FFT is computed alike on any thread, so the rates are the serial ones
+    for (a, b, r_seg, _, fr0), res in zip(jobs, one_thread_each(drift, jobs), strict=True):
         ok = res.converged and res.fr_hz_per_s < 0 and abs(res.fr_hz_per_s / fr0 - 1.0) < 0.3
         segments.append((r_seg, res.fr_hz_per_s, fr0, res.iterations, res.converged, bool(ok)))
         if ok:  # a segment without focusable content (noise, dark sea) does not converge: dropped

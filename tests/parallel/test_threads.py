@@ -9,7 +9,7 @@ import threading
 import numba
 import pytest
 
-from sarcli.threads import budget, fft_workers, limited, usable_cores
+from sarcli.threads import budget, fft_workers, limited, one_thread_each, usable_cores
 
 
 def test_default_budget_is_every_usable_core():
@@ -66,3 +66,21 @@ def test_the_package_sets_a_per_user_numba_cache(tmp_path):
     env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == str(tmp_path / "mine")
+
+
+def test_one_thread_each_runs_the_jobs_side_by_side_in_order_with_a_budget_of_one():
+    seen = []
+
+    def job(k):
+        seen.append(threading.current_thread().name)
+        return k * k, budget(), numba.get_num_threads()
+
+    with limited(3):  # a pool of 3 threads even on a smaller machine
+        out = one_thread_each(job, list(range(7)))
+    assert [o[0] for o in out] == [k * k for k in range(7)]  # in the jobs' order
+    assert all(o[1] == 1 and o[2] == 1 for o in out)  # each job under limited(1)
+    assert all(name != threading.main_thread().name for name in seen)
+    with limited(1):  # a budget of one: in this thread, serially
+        seen.clear()
+        assert [o[0] for o in one_thread_each(job, [2, 3])] == [4, 9]
+        assert seen == [threading.current_thread().name] * 2
