@@ -83,9 +83,16 @@ def upsample_range(rc: np.ndarray, factor: int, workers: int = -1) -> np.ndarray
 
 def backproject_grid(rc: np.ndarray, r_first: float, dr: float, wavelength: float, pos: np.ndarray,
                      vel: np.ndarray, pix: np.ndarray, r_ref: np.ndarray, fdc: np.ndarray, ba: float,
-                     window_spec: str, upsample: int = 8) -> np.ndarray:
-    """Backproject range-compressed lines onto pixels ``pix`` (M, 3): complex128 (M,)."""
+                     window_spec: str, upsample: int = 8, device: str = "cpu") -> np.ndarray:
+    """Backproject range-compressed lines onto pixels ``pix`` (M, 3): complex128 (M,) (``device`` cpu), or
+    complex64 from the GPU kernel (``device`` cuda: :func:`sarcli.gpu.bp_cuda.backproject_stripmap`)."""
     up = upsample_range(np.asarray(rc), upsample) if upsample > 1 else np.asarray(rc)
+    if device == "cuda":
+        from sarcli.gpu import bp_cuda
+        from sarcli.gpu.device import require_cuda
+
+        return bp_cuda.backproject_stripmap(require_cuda(), up, float(r_first), dr / upsample, float(wavelength), pos,
+                                            vel, pix, r_ref, fdc, float(ba), window_table(window_spec))
     out = np.zeros(pix.shape[0], np.complex128)
     backproject(up, float(r_first), dr / upsample, float(wavelength), np.ascontiguousarray(pos, np.float64),
                 np.ascontiguousarray(vel, np.float64), np.ascontiguousarray(pix, np.float64),

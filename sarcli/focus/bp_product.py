@@ -16,6 +16,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import scipy.fft as sfft
@@ -27,6 +28,7 @@ from sarcli.focus.geolocation import platform_state, zero_doppler_points
 from sarcli.focus.rangecomp import C, compress_lines, range_filter, reference_pulse
 from sarcli.focus.rda import OutputGrid, doppler_on_grid, plan_grid
 from sarcli.focus.windows import parse_window
+from sarcli.gpu.device import check_device
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import Terrain
@@ -37,7 +39,8 @@ class BpOptions:
     """Backprojection knobs: windows, bands and replica as the RDA (:class:`sarcli.focus.rda.RdOptions`);
     ``upsample``: range Fourier upsampling before the linear interpolation of each line;
     ``lines``/``samples``: the output window [a, b) of the RD grid (default: all of it);
-    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once)."""
+    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once);
+    ``device``: cpu, or cuda (the backprojection kernel on the GPU, :mod:`sarcli.gpu.bp_cuda`)."""
 
     range_window: str = "kaiser:2.5"
     range_bandwidth_fraction: float = 1.0
@@ -49,8 +52,10 @@ class BpOptions:
     samples: tuple[int, int] | None = None
     block_lines: int = 4096
     workers: int = -1
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
         parse_window(self.range_window)
         parse_window(self.azimuth_window)
         if not 1 <= self.upsample <= 64:
@@ -135,7 +140,7 @@ class Backprojection:
         fdc_pix = np.broadcast_to(plan.fdc[sa:sb][None, :], tt.shape).ravel()
         img = backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
                                pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
-                               k.upsample).reshape(tt.shape)
+                               k.upsample, k.device).reshape(tt.shape)
         plan.timings["backprojection_s"] = plan.timings.get("backprojection_s", 0.0) + time.perf_counter() - t0
         return img.astype(np.complex64)
 

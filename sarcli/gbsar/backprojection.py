@@ -98,11 +98,12 @@ def bp_reference(prof: np.ndarray, dr: float, xs, dz, valid, px, pr, kc, half_be
 
 
 def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_length_m: float | None,
-                azimuth_window: str = "hamming") -> np.ndarray:
+                azimuth_window: str = "hamming", device: str = "cpu") -> np.ndarray:
     """BP onto pixels at azimuth ``px`` and range ``pr`` (any equal shapes) -> complex64 of that shape.
 
     ``antenna_length_m`` = L_x limits each pixel's aperture to the beam footprint; None uses the whole rail.
     ``azimuth_window``: a taper spec (:mod:`sarcli.gbsar.windows`) over each pixel's aperture.
+    ``device``: cpu, or cuda (:func:`sarcli.gpu.bp_cuda.backproject_rail`, the same arithmetic).
     """
     table = taper_table(azimuth_window)
     px = np.asarray(px, np.float64)
@@ -113,8 +114,15 @@ def backproject(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_len
     dz = prof.heights_m - prof.heights_m.mean()
     kc = 4 * np.pi / prof.wavelength_m
     half = prof.wavelength_m / (2 * antenna_length_m) if antenna_length_m else 1e30
-    bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
-              half, table, out)
+    if device == "cuda":
+        from sarcli.gpu import bp_cuda
+        from sarcli.gpu.device import require_cuda
+
+        out = bp_cuda.backproject_rail(require_cuda(), prof.data, prof.dr_m, prof.positions_m, dz, prof.weights,
+                                       flat_x, flat_r, kc, half, table, _W_MIN)
+    else:
+        bp_kernel(np.ascontiguousarray(prof.data), prof.dr_m, prof.positions_m, dz, prof.weights, flat_x, flat_r, kc,
+                  half, table, out)
     return out.reshape(shape)
 
 
@@ -225,7 +233,7 @@ def bp_grid_reference(prof: np.ndarray, r_first: float, dr: float, ant: np.ndarr
 
 def backproject_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_range: np.ndarray | None,
                      xs: np.ndarray, ys: np.ndarray, z: float, azimuth_window: str = "hamming",
-                     ) -> tuple[np.ndarray, np.ndarray]:
+                     device: str = "cpu") -> tuple[np.ndarray, np.ndarray]:
     """BP of ``centred`` profiles (:func:`sarcli.gbsar.rangecomp.range_compress`) onto the horizontal
     grid ``ys`` x ``xs`` at height ``z`` of the scan frame -> ``(image (n_y, n_x) complex64, fraction)``.
 
@@ -240,7 +248,8 @@ def backproject_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_ran
     gives g = s at the scatterer (no carrier phase left: the image is the complex reflectivity), with
     w_i the ``azimuth_window`` taper over the sweeps in their stored (track) order times their
     validity. A stop whose rho_i falls outside the profile ([-R_max, R_max)) is left out; ``fraction`` is
-    the share of the weights a pixel used (1 inside the unambiguous window of every sweep).
+    the share of the weights a pixel used (1 inside the unambiguous window of every sweep). ``device``: cpu,
+    or cuda (:func:`sarcli.gpu.bp_cuda.backproject_grid`, the same arithmetic, float32 accumulation).
 
     De-ramped phase histories are this model with r_i the de-ramp reference: dechirping on receive
     against a copy delayed by 2 r_i/c and removing the residual video phase leaves, at instantaneous
@@ -258,6 +267,13 @@ def backproject_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_ran
     total = float(w.sum())
     xs = np.ascontiguousarray(xs, np.float64)
     ys = np.ascontiguousarray(ys, np.float64)
+    if device == "cuda":  # the same arithmetic on the GPU (sarcli.gpu.bp_cuda), float32 accumulation
+        from sarcli.gpu import bp_cuda
+        from sarcli.gpu.device import require_cuda
+
+        img, used_gpu = bp_cuda.backproject_grid(require_cuda(), prof.data, prof.first_range_m, prof.dr_m, ant, ref, w,
+                                                 xs, ys, float(z), 4 * np.pi / prof.wavelength_m)
+        return (img / total).astype(np.complex64), used_gpu / total
     out = np.zeros((ys.size, xs.size), np.complex128)
     used = np.zeros((ys.size, xs.size))
     bp_grid_kernel(np.ascontiguousarray(prof.data.real, np.float64), np.ascontiguousarray(prof.data.imag, np.float64),

@@ -36,6 +36,7 @@ from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress, w
 from sarcli.gbsar.rangedoppler import focus_rd_pols, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
 from sarcli.gbsar.windows import parse_taper
+from sarcli.gpu.device import check_device
 from sarcli.model.gbsar import Scan
 
 ALGORITHMS = ("auto", "df", "rd", "bp")
@@ -99,7 +100,9 @@ class FocusOptions:
     ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect;
     ``grid_m``: (x0, x1, dx, y0, y1, dy[, z]) backprojects onto that horizontal grid instead (module
     docstring; ``auto`` means BP there, and the slant-grid options must stay unset);
-    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1).
+    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1); ``device``: cpu, or
+    cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU (:mod:`sarcli.gpu.bp_cuda`; DF
+    and RD stay on the CPU).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
@@ -119,8 +122,10 @@ class FocusOptions:
     rd_reference: Literal["sinc", "rect"] = "sinc"
     grid_m: tuple[float, ...] = ()
     permittivity: float = 1.0
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
         if self.algorithm not in ALGORITHMS:
             raise ConfigError(f"unknown algorithm '{self.algorithm}' (use {', '.join(ALGORITHMS)})")
         if self.near not in ("rd", "bp"):
@@ -224,7 +229,7 @@ def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
     prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
     return backproject(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
-                       opts.azimuth_window)
+                       opts.azimuth_window, opts.device)
 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
@@ -378,7 +383,7 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
         if np.all(prof.weights == 0):
             raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
         image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
-                                           opts.azimuth_window)
+                                           opts.azimuth_window, opts.device)
     amap = np.where(frac > 0, ALG_CODE["bp"], 0).astype(np.uint8)
     report = {
         "algorithm": opts.algorithm, "used": {"bp": [float(plane.ys[0]), float(plane.ys[-1])]},

@@ -52,6 +52,7 @@ class Config:
     with looks_az x looks_rg looks, the GeoTIFFs' tiles compressed by ``geotiff_compression``
     (``sarcli.io.images.COMPRESSIONS``); channel: receive channel (0 = /echo);
     accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved;
+    device: cpu | cuda, the focuser's ``device`` option (None: the focuser's default, cpu);
     workers / threads_per_worker / scheduler: focus the blocks in parallel on a local Dask cluster of
     that many processes, or on the scheduler at that address (:mod:`sarcli.parallel.cluster`); they
     do not change the image and are not stored in the product.
@@ -77,6 +78,7 @@ class Config:
     looks_rg: int = 1
     channel: int = 0
     accept_unresolved_ambiguity: bool = False
+    device: Literal["cpu", "cuda"] | None = None
     workers: int | None = None
     threads_per_worker: int = 1
     scheduler: str | None = None
@@ -97,6 +99,8 @@ class Config:
                 raise ConfigError(f"--{name.replace('_m', '')} must be a finite number, got {v}")
         if self.channel < 0:
             raise ConfigError(f"--channel must be >= 0, got {self.channel}")
+        if self.device == "cuda" and (self.workers or self.scheduler):
+            raise ConfigError("--device cuda focuses on the GPU in this process: drop --workers/--scheduler")
         from sarcli.io.images import compression_options
 
         compression_options(self.geotiff_compression)  # one line naming the choices if unknown
@@ -197,6 +201,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     start_probing()  # the inputs' metadata probe starts while the focusers are imported
     from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, options_for, run_blocks
+    from sarcli.gpu.device import options_with_device
     from sarcli.io.atomic import all_or_nothing
 
     progress = progress or no_progress
@@ -205,7 +210,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         refuse_overwriting_inputs((config.raw, config.doppler, config.dem), config.outputs)
         _check_outputs(config)
         focuser = FOCUSERS.get(config.algorithm)
-        options = options_for(focuser, config.options)
+        options = options_for(focuser, options_with_device(focuser.Options, config.options, config.device))
         from sarcli.io.dem import load_terrain
         from sarcli.io.raw import raw_shape, read_raw
 

@@ -74,6 +74,9 @@ def focus(
                                 "this many processes (the same image)."),
     scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
                                   "scheduler (tcp://host:8786; the raw file must be visible to its workers)."),
+    device: str = typer.Option(None, "--device", metavar="[cpu|cuda]", envvar="SARCLI_DEVICE",
+                               help="Where the focuser runs: cpu (default) or cuda (rd and backprojection; needs "
+                               "a GPU and the gpu extra, docs/parallel.md)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON report on stdout."),
 ) -> None:
     """Focus a stripmap raw product into a single-look complex image.
@@ -99,6 +102,8 @@ def focus(
       sarcli focus raw.h5 -o bp.h5 --algorithm backprojection --set lines=[900,1000] --range-window rect
 
       sarcli focus big_raw.h5 -o slc.h5 --fdc -6690 --fr -1990 --workers 2
+
+      sarcli focus raw.h5 -o slc.h5 --device cuda    # on the GPU (pip install 'sarcli[gpu]')
     """
     given = {"range_window": range_window, "azimuth_window": azimuth_window, "azimuth_bandwidth": azimuth_bandwidth,
              "range_band_fraction": range_band_fraction, "rcmc": rcmc, "rcmc_oversample": rcmc_oversample,
@@ -118,7 +123,8 @@ def focus(
                     geotiff_slant=geotiff_slant, geotiff_compression=geotiff_compression, quicklook=quicklook,
                     crs=crs, pixel_spacing_m=spacing,
                     looks_az=looks_az, looks_rg=looks_rg, channel=channel,
-                    accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler)
+                    accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler,
+                    device=_device(device))
     with progress_bar(1, label="focusing") as bar:
         def progress(label: str, done: int, total: int) -> None:
             bar.length = total
@@ -132,6 +138,16 @@ def focus(
     else:
         for line in rep.lines():
             info(line)
+
+
+def _device(name: str | None) -> str | None:
+    """``--device`` (or ``SARCLI_DEVICE``) checked: cpu | cuda, or None when neither is given."""
+    if name is None or not name.strip():
+        return None
+    d = name.strip().lower()
+    if d not in ("cpu", "cuda"):
+        raise ConfigError(f"--device must be cpu or cuda, got {name!r}")
+    return d
 
 
 def _geoid(name: str | None):
