@@ -55,7 +55,10 @@ class Cuda:
     name: str
 
     def asarray(self, a: Any, dtype: Any = None) -> Any:
-        """``a`` on the device (a copy to the card with CuPy)."""
+        """``a`` on the device: a copy to the card with CuPy; under the simulator a writable host copy (the
+        simulator copies every kernel argument back, which a read-only view would refuse)."""
+        if self.simulator:
+            return np.array(a, dtype=dtype, copy=True)
         return self.xp.asarray(a, dtype=dtype)
 
     def to_host(self, a: Any) -> np.ndarray:

@@ -6,7 +6,8 @@ and azimuth matched filter, azimuth IFFT) and does step 6 (the per-line correcti
 on the CPU as always, so the plan, the blocks and hence the block invariance are the CPU's. The code is written
 once with ``xp``: on the card ``xp`` is CuPy (cuFFT, element-wise kernels); the tests run the very same
 functions with ``xp = numpy`` and compare them with the numba CPU kernels. The azimuth-frequency rows are
-processed in tiles of ``ROWS`` (each row is independent: the tile size changes the memory, never the image).
+processed in tiles of ``ROWS`` (each row is independent: the tile size changes the memory, and the image only by
+the FFT library's batching of rows, float32 round-off: tests/gpu/test_rd_xp.py).
 
 The RCMC/azimuth filter here evaluates the geometry (range position and phase) exactly at every sample with the
 CPU kernel's own tables (window: linear lookup in a 4097-point table; sinc: the nearest of 2048 phases), where

@@ -103,7 +103,8 @@ def test_cpu_focus_imports_no_gpu_package(tmp_path):
         "        app(args)\n"
         "    except SystemExit as e:\n"
         "        assert not e.code, e.code\n"
-        "print(json.dumps(sorted(m for m in sys.modules if m.startswith(('cupy', 'numba.cuda', 'sarcli.gpu.bp_cuda', 'sarcli.gpu.rd_xp')))))\n")
+        "gpu = ('cupy', 'numba.cuda', 'sarcli.gpu.bp_cuda', 'sarcli.gpu.rd_xp')\n"
+        "print(json.dumps(sorted(m for m in sys.modules if m.startswith(gpu))))\n")
     env = {**os.environ, "PYTHONPATH": str(REPO), "SARCLI_NO_PROGRESS": "1"}
     env.pop("NUMBA_ENABLE_CUDASIM", None)
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env, capture_output=True, text=True, timeout=600)
