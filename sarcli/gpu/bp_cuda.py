@@ -63,7 +63,7 @@ def _table(tab, u):
 
 
 @cuda.jit
-def _stripmap_kernel(rc_re, rc_im, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba, wtab, out_re, out_im):
+def stripmap_kernel(rc_re, rc_im, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba, wtab, out_re, out_im):
     m = cuda.grid(1)
     if m >= pix.shape[0]:
         return
@@ -96,7 +96,7 @@ def _stripmap_kernel(rc_re, rc_im, r_first, dr, wavelength, pos, vel, pix, r_ref
 
 
 @cuda.jit
-def _rail_kernel(p_re, p_im, dr, xs, dz, valid, px, pr, kc, half_beam, table, w_min, out_re, out_im):
+def rail_kernel(p_re, p_im, dr, xs, dz, valid, px, pr, kc, half_beam, table, w_min, out_re, out_im):
     p = cuda.grid(1)
     if p >= px.shape[0]:
         return
@@ -142,7 +142,7 @@ def _rail_kernel(p_re, p_im, dr, xs, dz, valid, px, pr, kc, half_beam, table, w_
 
 
 @cuda.jit
-def _grid_kernel(p_re, p_im, r_first, dr, ant, ref, w, xs, ys, z, kc, out_re, out_im, used):
+def grid_kernel(p_re, p_im, r_first, dr, ant, ref, w, xs, ys, z, kc, out_re, out_im, used):
     k, iy = cuda.grid(2)
     if k >= xs.shape[0] or iy >= ys.shape[0]:
         return
@@ -197,7 +197,7 @@ def backproject_stripmap(dev: Cuda, rc: np.ndarray, r_first: float, dr: float, w
     re, im = _split32(dev, rc)
     out_re = dev.xp.zeros(m, dev.xp.float32)
     out_im = dev.xp.zeros(m, dev.xp.float32)
-    _stripmap_kernel[_blocks(m), THREADS](re, im, float(r_first), float(dr), float(wavelength), _f64(dev, pos),
+    stripmap_kernel[_blocks(m), THREADS](re, im, float(r_first), float(dr), float(wavelength), _f64(dev, pos),
                                           _f64(dev, vel), _f64(dev, pix), _f64(dev, r_ref), _f64(dev, fdc),
                                           float(ba), _f64(dev, wtab), out_re, out_im)
     return (dev.to_host(out_re) + 1j * dev.to_host(out_im)).astype(np.complex64)
@@ -211,7 +211,7 @@ def backproject_rail(dev: Cuda, prof: np.ndarray, dr: float, xs: np.ndarray, dz:
     re, im = _split32(dev, prof)
     out_re = dev.xp.zeros(n, dev.xp.float32)
     out_im = dev.xp.zeros(n, dev.xp.float32)
-    _rail_kernel[_blocks(n), THREADS](re, im, float(dr), _f64(dev, xs), _f64(dev, dz), _f64(dev, valid),
+    rail_kernel[_blocks(n), THREADS](re, im, float(dr), _f64(dev, xs), _f64(dev, dz), _f64(dev, valid),
                                       _f64(dev, px), _f64(dev, pr), float(kc), float(half_beam), _f64(dev, table),
                                       float(w_min), out_re, out_im)
     return (dev.to_host(out_re) + 1j * dev.to_host(out_im)).astype(np.complex64)
@@ -229,6 +229,6 @@ def backproject_grid(dev: Cuda, prof: np.ndarray, r_first: float, dr: float, ant
     used = dev.xp.zeros((ny, nx), dev.xp.float64)
     tx, ty = 32, THREADS // 32
     grid = ((nx + tx - 1) // tx, (ny + ty - 1) // ty)
-    _grid_kernel[grid, (tx, ty)](re, im, float(r_first), float(dr), _f64(dev, ant), _f64(dev, ref), _f64(dev, w),
+    grid_kernel[grid, (tx, ty)](re, im, float(r_first), float(dr), _f64(dev, ant), _f64(dev, ref), _f64(dev, w),
                                  _f64(dev, xs), _f64(dev, ys), float(z), float(kc), out_re, out_im, used)
     return (dev.to_host(out_re) + 1j * dev.to_host(out_im)).astype(np.complex64), dev.to_host(used)
