@@ -22,6 +22,25 @@ from numba import njit, prange
 from sarcli.focus.windows import table_lookup, window, window_table
 from sarcli.threads import fft_workers
 
+#: fast-math flags of the float32 kernels: no NaN/inf/signed-zero care (lets the selects and the loops
+#: vectorize) but no ``contract`` (FMA) and no ``reassoc``: every product is the rounded IEEE product the
+#: error bounds of :mod:`sarcli.focus.phasor` assume, the same in the vector body and the scalar tail of a
+#: loop, so a pixel's value does not depend on where a tile boundary or a thread split puts it
+FLOAT32_FLAGS = {"nnan", "ninf", "nsz"}
+
+
+def lerp_pairs(lines: np.ndarray) -> np.ndarray:
+    """(n, m) complex lines -> (n, m) complex128 *view* of complex64 pairs ``(x_j, x_{j+1} - x_j)``
+    (``x_m = x_{m-1}``): the float32 kernels' linear interpolation ``x_j + t (x_{j+1} - x_j)`` reads one
+    16-byte element per sample (one scalar load where a vector gather does not pay), the difference
+    rounded to float32 exactly as a kernel computing it in place would."""
+    x = np.asarray(lines).astype(np.complex64, copy=False)
+    pair = np.empty(x.shape + (2,), np.complex64)
+    pair[..., 0] = x
+    pair[:, :-1, 1] = x[:, 1:] - x[:, :-1]
+    pair[:, -1, 1] = 0
+    return pair.view(np.complex128)[..., 0]
+
 
 @njit(parallel=True, cache=True)
 def backproject(rc, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba, wtab, out):
