@@ -16,6 +16,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import scipy.fft as sfft
@@ -37,7 +38,9 @@ class BpOptions:
     """Backprojection knobs: windows, bands and replica as the RDA (:class:`sarcli.focus.rda.RdOptions`);
     ``upsample``: range Fourier upsampling before the linear interpolation of each line;
     ``lines``/``samples``: the output window [a, b) of the RD grid (default: all of it);
-    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once)."""
+    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once);
+    ``precision``: single (float32 phasor-recurrence kernel) | double (the complex128 reference kernel)
+    (:mod:`sarcli.focus.backprojection`)."""
 
     range_window: str = "kaiser:2.5"
     range_bandwidth_fraction: float = 1.0
@@ -49,12 +52,15 @@ class BpOptions:
     samples: tuple[int, int] | None = None
     block_lines: int = 4096
     workers: int = -1
+    precision: Literal["single", "double"] = "single"
 
     def __post_init__(self) -> None:
         parse_window(self.range_window)
         parse_window(self.azimuth_window)
         if not 1 <= self.upsample <= 64:
             raise ConfigError(f"upsample must be 1..64, got {self.upsample}")
+        if self.precision not in ("single", "double"):
+            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
         if self.block_lines < 1:
             raise ConfigError(f"block_lines must be positive, got {self.block_lines}")
         if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
@@ -135,7 +141,7 @@ class Backprojection:
         fdc_pix = np.broadcast_to(plan.fdc[sa:sb][None, :], tt.shape).ravel()
         img = backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
                                pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
-                               k.upsample).reshape(tt.shape)
+                               k.upsample, k.precision, first_line=a).reshape(tt.shape)
         plan.timings["backprojection_s"] = plan.timings.get("backprojection_s", 0.0) + time.perf_counter() - t0
         return img.astype(np.complex64)
 
