@@ -85,20 +85,34 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
     :mod:`sarcli.focus.phasor` (a float64 anchor on the block's first line, before which a virtual line
     at ``2 P_0 - P_1`` stands, and on every line whose index ``first_line + n`` is a multiple of ``every``:
     a pixel whose band starts ``every`` lines into two blocks gets the same bits from both); the band and
-    range tests and the window position are :func:`backproject`'s expressions; interpolation, window and
-    sums in float32. Tiles of ``tile`` consecutive pixels run in parallel, each integrating the lines in
+    range tests and the window position as there but with reciprocals for two of the divisions (a sample
+    within ~1e-16 of a band edge may fall the other way); interpolation, window and sums in float32. Tiles of ``tile`` consecutive pixels run in parallel, each integrating the lines in
     order: bit-identical whatever the tiling or the number of threads. Per line: a vectorized pass (range,
     phasor, Doppler, index), skipped onward where no pixel of the tile sees the line in its band, a scalar
     pass reading the pairs and the window table, a vectorized pass accumulating."""
     na, nr = pairs.shape
     n_pix = pix.shape[0]
     k4 = 4.0 * np.pi / wavelength
+    two_over_lam = 2.0 / wavelength
+    inv_ba = 1.0 / ba
+    inv_dr = 1.0 / dr
     top = nr - 1.0
     nw = wtab.shape[0]
     zero = np.float32(0.0)
     for t in prange((n_pix + tile - 1) // tile):
         m0 = t * tile
         nm = min(tile, n_pix - m0)
+        qx = np.empty(nm)
+        qy = np.empty(nm)
+        qz = np.empty(nm)
+        qr = np.empty(nm)
+        qf = np.empty(nm)
+        for c in range(nm):  # the tile's pixels as contiguous arrays: the passes below vectorize
+            qx[c] = pix[m0 + c, 0]
+            qy[c] = pix[m0 + c, 1]
+            qz[c] = pix[m0 + c, 2]
+            qr[c] = r_ref[m0 + c]
+            qf[c] = fdc[m0 + c]
         rr = np.empty(nm)
         rho = np.empty(nm)
         dlt = np.empty(nm)
@@ -110,8 +124,11 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
         acc_im = np.zeros(nm, np.float32)
         jj = np.empty(nm, np.uint64)
         ff = np.empty(nm, np.float32)
-        uw = np.empty(nm)
-        okk = np.empty(nm, np.bool_)
+        kk = np.empty(nm, np.uint64)
+        aw = np.empty(nm)
+        w0 = np.empty(nm)
+        w1 = np.empty(nm)
+        okk = np.empty(nm, np.float32)
         ww = np.empty(nm, np.float32)
         val = np.empty(nm, np.complex128)
         q = val.view(np.float32)
@@ -127,17 +144,16 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
                 else:
                     b0, b1, b2 = p0, p1, p2
                 for c in range(nm):
-                    m = m0 + c
-                    dx = pix[m, 0] - p0
-                    dy = pix[m, 1] - p1
-                    dz = pix[m, 2] - p2
-                    ex = pix[m, 0] - b0
-                    ey = pix[m, 1] - b1
-                    ez = pix[m, 2] - b2
+                    dx = qx[c] - p0
+                    dy = qy[c] - p1
+                    dz = qz[c] - p2
+                    ex = qx[c] - b0
+                    ey = qy[c] - b1
+                    ez = qz[c] - b2
                     r = np.sqrt(dx * dx + dy * dy + dz * dz)
                     rr[c] = r
-                    rh = r - r_ref[m]
-                    dl = rh - (np.sqrt(ex * ex + ey * ey + ez * ez) - r_ref[m])
+                    rh = r - qr[c]
+                    dl = rh - (np.sqrt(ex * ex + ey * ey + ez * ez) - qr[c])
                     c1, s1 = cis(k4 * rh)
                     c2, s2 = cis(k4 * dl)
                     pre[c] = np.float32(c1)
@@ -148,13 +164,12 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
                     dlt[c] = dl
             else:  # D <- D exp(j eps), P <- P D
                 for c in range(nm):
-                    m = m0 + c
-                    dx = pix[m, 0] - p0
-                    dy = pix[m, 1] - p1
-                    dz = pix[m, 2] - p2
+                    dx = qx[c] - p0
+                    dy = qy[c] - p1
+                    dz = qz[c] - p2
                     r = np.sqrt(dx * dx + dy * dy + dz * dz)
                     rr[c] = r
-                    rh = r - r_ref[m]
+                    rh = r - qr[c]
                     dl = rh - rho[c]
                     ec, es = cis_step(np.float32(k4 * (dl - dlt[c])))
                     a = dre[c]
@@ -174,34 +189,33 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
             v1 = vel[n, 1]
             v2 = vel[n, 2]
             for c in range(nm):
-                m = m0 + c
-                dx = pix[m, 0] - p0
-                dy = pix[m, 1] - p1
-                dz = pix[m, 2] - p2
+                dx = qx[c] - p0
+                dy = qy[c] - p1
+                dz = qz[c] - p2
                 r = rr[c]
-                # the expressions of backproject, operation for operation: the same lines in the band
-                u = (2.0 * (v0 * dx + v1 * dy + v2 * dz) / (wavelength * r) - fdc[m]) / ba
-                p = (r - r_first) / dr
+                u = ((v0 * dx + v1 * dy + v2 * dz) * two_over_lam / r - qf[c]) * inv_ba
+                p = (r - r_first) * inv_dr
                 ok = (u >= -0.5) & (u <= 0.5) & (p >= 0.0) & (p < top)
                 pc = p if ok else 0.0
                 j = np.uint64(pc)
                 jj[c] = j
                 ff[c] = np.float32(pc - j)
-                uw[c] = u if ok else 0.0
-                okk[c] = ok
-                seen += ok
+                # window_table lookup (table_lookup's arithmetic), the table read in the scalar pass
+                tw = ((u if ok else 0.0) + 0.5) * (nw - 1)
+                k = min(np.uint64(tw), np.uint64(nw - 2))
+                kk[c] = k
+                aw[c] = tw - k
+                okk[c] = np.float32(1.0) if ok else zero
+                seen += 1 if ok else 0
             if seen == 0:
                 continue
             line = pairs[n]
             for c in range(nm):
                 val[c] = line[jj[c]]
-                if okk[c]:
-                    tw = (uw[c] + 0.5) * (nw - 1)
-                    k = min(int(tw), nw - 2)
-                    a = tw - k
-                    ww[c] = np.float32(wtab[k] * (1.0 - a) + wtab[k + 1] * a)
-                else:
-                    ww[c] = zero
+                w0[c] = wtab[kk[c]]
+                w1[c] = wtab[kk[c] + np.uint64(1)]
+            for c in range(nm):
+                ww[c] = np.float32(w0[c] * (1.0 - aw[c]) + w1[c] * aw[c]) * okk[c]
             for c in range(nm):
                 f = ff[c]
                 vr = q[4 * c] + f * q[4 * c + 2]
@@ -259,7 +273,7 @@ def upsample_range(rc: np.ndarray, factor: int, workers: int = -1) -> np.ndarray
 
 
 #: pixels per tile of :func:`backproject32`
-LINE_TILE = 64
+LINE_TILE = 256
 
 
 def backproject_grid(rc: np.ndarray, r_first: float, dr: float, wavelength: float, pos: np.ndarray,

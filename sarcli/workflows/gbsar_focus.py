@@ -61,6 +61,7 @@ class Config:
     quicklook: Path | None = None
     grid_m: tuple[float, ...] | None = None
     permittivity: float = 1.0
+    bp_precision: Literal["single", "double"] = "single"
 
     def __post_init__(self) -> None:
         self.options()  # every option checked when the configuration is made, before any file is opened
@@ -74,7 +75,8 @@ class Config:
                             azimuth_window=self.azimuth_window, max_range_m=self.max_range_m,
                             min_range_m=self.min_range_m, pixel_x_m=self.pixel_x_m, width_m=self.width_m,
                             criterion_rad=criterion_rad(self.criterion_deg), near=self.near, n_xfft=self.n_xfft,
-                            rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity)
+                            rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity,
+                            bp_precision=self.bp_precision)
 
 
 @dataclass

@@ -166,3 +166,32 @@ def test_backproject_grid_precisions_agree():
     assert np.abs(single.astype(complex) - double).max() <= bound
     with pytest.raises(ConfigError, match="precision"):
         backproject_grid(rp, ant, ref, xs, ys, 0.0, "rect", precision="half")
+
+
+def test_cli_double_selects_the_float64_kernel(cli, tmp_path):
+    """``gbsar focus --grid ... --double``: the report names the kernel, and the two products of an
+    imported unit point target agree within the float32 bound: its profiles are exp(-j kc rho) W with
+    |W| <= W(0) = 1, so sum_i w_i |v_i| / sum_i w_i <= 1 and the normalized error is at most the per-term
+    bound (phasor, ranges, 6 u) plus the sum's (n - 1) u, plus the float32 division by sum w and the
+    complex64 rounding of the float64 image (u each)."""
+    import json
+
+    from sarcli.io.gbsar_image import read_gbsar_image
+    from tests.gbsar.test_import_focus import TARGET, TRACK, F, _gotcha_like_file
+
+    d = np.linalg.norm(TRACK - TARGET, axis=1) - np.linalg.norm(TRACK, axis=1)
+    _gotcha_like_file(tmp_path / "t.mat", np.exp(-4j * np.pi * np.outer(d, F) / C_LIGHT))
+    scan = tmp_path / "t.h5"
+    assert cli("gbsar", "import", tmp_path / "t.mat", "-o", scan).exit_code == 0
+    grid = ("--grid", "0.6,1.8,0.05,-1.4,-0.2,0.05,0.3")
+    images = {}
+    for name, extra in (("single", ()), ("double", ("--double",))):
+        r = cli("gbsar", "focus", scan, "-o", tmp_path / f"{name}.h5", *grid, "--json", *extra)
+        assert r.exit_code == 0, r.stderr
+        assert json.loads(r.stdout)["bp_precision"] == name
+        images[name] = read_gbsar_image(tmp_path / f"{name}.h5").image[0].astype(complex)
+    kc = 4 * np.pi * F.mean() / C_LIGHT
+    bound = (recurrence_bound(ANCHOR_EVERY - 1) + 2 * range_phase_bound(kc, 200.0)
+             + (6 + TRACK.shape[0] - 1) * U32 + 2 * U32)
+    assert np.abs(images["double"]).max() == pytest.approx(1.0, abs=0.05)  # the unit target is on the grid
+    assert np.abs(images["single"] - images["double"]).max() <= bound

@@ -147,6 +147,8 @@ def focus_cmd(
                              "grid of the scan's frame (z default 0) instead of the rail's slant plane."),
     permittivity: float = typer.Option(1.0, "--permittivity", help="Relative permittivity of the medium: waves "
                                        "travel at c/sqrt(EPS), image ranges are distances in it (e.g. depth)."),
+    double: bool = typer.Option(False, "--double", help="--grid backprojection with the float64 kernel (the "
+                                "reference; default: float32 phasor recurrence, within 4e-5 of it)."),
     json_out: bool = typer.Option(False, "--json", help="Print the focusing report as JSON on stdout."),
 ) -> None:
     """Focus a scan: range compression, then DF, RD, BP or auto (DF beyond the eq. 12 limit, BP/RD nearer).
@@ -177,7 +179,7 @@ def focus_cmd(
                     n_xfft=n_xfft, rd_reference=rd_reference, range_window=range_window,
                     azimuth_window=azimuth_window, geotiff=geotiff, enu_geotiff=enu_geotiff, map_pixel_m=map_pixel,
                     ground_height_m=ground_height, quicklook=quicklook, grid_m=_numbers("--grid", grid),
-                    permittivity=permittivity)
+                    permittivity=permittivity, bp_precision="double" if double else "single")
     run_workflow(wf, cfg, json_out)
 
 
