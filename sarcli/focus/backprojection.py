@@ -86,10 +86,12 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
     at ``2 P_0 - P_1`` stands, and on every line whose index ``first_line + n`` is a multiple of ``every``:
     a pixel whose band starts ``every`` lines into two blocks gets the same bits from both); the band and
     range tests and the window position as there but with reciprocals for two of the divisions (a sample
-    within ~1e-16 of a band edge may fall the other way); interpolation, window and sums in float32. Tiles of ``tile`` consecutive pixels run in parallel, each integrating the lines in
-    order: bit-identical whatever the tiling or the number of threads. Per line: a vectorized pass (range,
-    phasor, Doppler, index), skipped onward where no pixel of the tile sees the line in its band, a scalar
-    pass reading the pairs and the window table, a vectorized pass accumulating."""
+    within ~1e-16 of a band edge may fall the other way); interpolation, window and sums in float32.
+    Tiles of ``tile`` consecutive pixels (copied to contiguous arrays) run in parallel, each integrating
+    the lines in order: bit-identical whatever the tiling or the number of threads. Per line: a
+    vectorized phasor pass, a vectorized pass for the Doppler, window position and range index (the rest
+    skipped where no pixel of the tile sees the line in its band), a scalar pass reading the pairs and the
+    window table, a vectorized pass weighting and accumulating."""
     na, nr = pairs.shape
     n_pix = pix.shape[0]
     k4 = 4.0 * np.pi / wavelength
