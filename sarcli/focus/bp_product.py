@@ -40,7 +40,9 @@ class BpOptions:
     ``upsample``: range Fourier upsampling before the linear interpolation of each line;
     ``lines``/``samples``: the output window [a, b) of the RD grid (default: all of it);
     ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once);
-    ``device``: cpu, or cuda (the backprojection kernel on the GPU, :mod:`sarcli.gpu.bp_cuda`)."""
+    ``precision``: single (float32 phasor-recurrence kernel) | double (the complex128 reference kernel)
+    (:mod:`sarcli.focus.backprojection`); ``device``: cpu, or cuda (the backprojection kernel on the GPU,
+    :mod:`sarcli.gpu.bp_cuda`)."""
 
     range_window: str = "kaiser:2.5"
     range_bandwidth_fraction: float = 1.0
@@ -52,6 +54,7 @@ class BpOptions:
     samples: tuple[int, int] | None = None
     block_lines: int = 4096
     workers: int = -1
+    precision: Literal["single", "double"] = "single"
     device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
@@ -60,6 +63,8 @@ class BpOptions:
         parse_window(self.azimuth_window)
         if not 1 <= self.upsample <= 64:
             raise ConfigError(f"upsample must be 1..64, got {self.upsample}")
+        if self.precision not in ("single", "double"):
+            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
         if self.block_lines < 1:
             raise ConfigError(f"block_lines must be positive, got {self.block_lines}")
         if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
@@ -140,7 +145,7 @@ class Backprojection:
         fdc_pix = np.broadcast_to(plan.fdc[sa:sb][None, :], tt.shape).ravel()
         img = backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
                                pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
-                               k.upsample, k.device).reshape(tt.shape)
+                               k.upsample, k.precision, first_line=a, device=k.device).reshape(tt.shape)
         plan.timings["backprojection_s"] = plan.timings.get("backprojection_s", 0.0) + time.perf_counter() - t0
         return img.astype(np.complex64)
 

@@ -100,9 +100,10 @@ class FocusOptions:
     ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect;
     ``grid_m``: (x0, x1, dx, y0, y1, dy[, z]) backprojects onto that horizontal grid instead (module
     docstring; ``auto`` means BP there, and the slant-grid options must stay unset);
-    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1); ``device``: cpu, or
-    cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU (:mod:`sarcli.gpu.bp_cuda`; DF
-    and RD stay on the CPU).
+    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1);
+    ``bp_precision``: single | double, the grid backprojection kernel (float32 phasor recurrence or float64);
+    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU
+    (:mod:`sarcli.gpu.bp_cuda`; DF and RD stay on the CPU).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
@@ -122,6 +123,7 @@ class FocusOptions:
     rd_reference: Literal["sinc", "rect"] = "sinc"
     grid_m: tuple[float, ...] = ()
     permittivity: float = 1.0
+    bp_precision: Literal["single", "double"] = "single"
     device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
@@ -148,6 +150,8 @@ class FocusOptions:
                 raise ConfigError(f"{name} must be >= 1, got {getattr(self, name)}")
         if not (math.isfinite(self.permittivity) and self.permittivity >= 1.0):
             raise ConfigError(f"--permittivity must be a relative permittivity >= 1, got {self.permittivity:g}")
+        if self.bp_precision not in ("single", "double"):
+            raise ConfigError(f"bp_precision must be 'single' or 'double', not '{self.bp_precision}'")
         if self.grid_m:
             self.plane_grid()
             if self.algorithm not in ("bp", "auto"):
@@ -383,7 +387,7 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
         if np.all(prof.weights == 0):
             raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
         image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
-                                           opts.azimuth_window, opts.device)
+                                           opts.azimuth_window, opts.bp_precision, opts.device)
     amap = np.where(frac > 0, ALG_CODE["bp"], 0).astype(np.uint8)
     report = {
         "algorithm": opts.algorithm, "used": {"bp": [float(plane.ys[0]), float(plane.ys[-1])]},
@@ -395,7 +399,7 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
         "full_aperture_fraction": float(np.mean(frac >= 1.0 - 1e-9)),
         "skipped_stops": list(prof.skipped), "seconds": {"bp": time.perf_counter() - t0},
         "polarizations": list(pols), "range_window": opts.range_window, "azimuth_window": opts.azimuth_window,
-        "footprint_antenna_length_m": None, "permittivity": opts.permittivity,
+        "footprint_antenna_length_m": None, "permittivity": opts.permittivity, "bp_precision": opts.bp_precision,
     }
     return Focused(image=image, grid=Grid(ranges=plane.ys, azimuths=plane.xs), algorithm_map=amap, report=report)
 

@@ -61,6 +61,7 @@ class Config:
     quicklook: Path | None = None
     grid_m: tuple[float, ...] | None = None
     permittivity: float = 1.0
+    bp_precision: Literal["single", "double"] = "single"
     device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
@@ -76,7 +77,7 @@ class Config:
                             min_range_m=self.min_range_m, pixel_x_m=self.pixel_x_m, width_m=self.width_m,
                             criterion_rad=criterion_rad(self.criterion_deg), near=self.near, n_xfft=self.n_xfft,
                             rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity,
-                            device=self.device)
+                            bp_precision=self.bp_precision, device=self.device)
 
 
 @dataclass
