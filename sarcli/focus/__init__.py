@@ -21,6 +21,7 @@ from sarcli.registry import Registry
 
 FOCUSERS: Registry = Registry("focuser", "sarcli.focusers", {
     "rd": "sarcli.focus.rda:RD",
+    "csa": "sarcli.focus.csa:CSA",
     "backprojection": "sarcli.focus.bp_product:BACKPROJECTION",
     "optical": "sarcli.optical.focus_plugin:OPTICAL",
 }, check=check_focuser)
