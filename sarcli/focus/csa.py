@@ -17,12 +17,16 @@ range-Doppler domain (azimuth FFT of the raw lines, stationary phase) [CumWong20
 the second-order expansion in range frequency f_tau of the exact 2-D phase
 -(4 pi R0 / c) sqrt((f0 + f_tau)^2 - (c f / 2V)^2) - pi f_tau^2 / K gives the range-Doppler-domain
 chirp rate Km, i.e. K with secondary range compression (Z = 1 / K_src of
-:func:`sarcli.focus.rangecomp.inverse_src_rate`). Per block the reference range R_ref (knob, default
-the middle of the imaged closest ranges) fixes V_r = V(R_ref), the reference frequency f_ref = fdc(R_ref) and, per azimuth-frequency
-row, the absolute f = f_ref + wrap(f_bin - f_ref) (one per row: the centroid may vary across the swath
-by at most (PRF - Ba) / 2, checked), D = D(f, V_r), D_ref = D(f_ref, V_r) and Km = Km(f, R_ref).
+:func:`sarcli.focus.rangecomp.inverse_src_rate`). The reference range R_ref (knob, default the middle
+of the imaged closest ranges) fixes, per block, V_r = V(R_ref), f_ref = fdc(R_ref) and, per
+azimuth-frequency row, the absolute f = f_ref + wrap(f_bin - f_ref) (one per row: the centroid may vary
+across the swath by at most (PRF - Ba) / 2, checked), D = D(f, V_r), Km = Km(f, R_ref); the migration
+every target is scaled to, D_ref = D(fdc, V) at R_ref and the scene centre, is the plan's (a block's
+own would put the range read of step 3 at block-dependent fractions of a sample: 0.56 sample for 50 Hz
+of centroid at 3.4 PRF, 0.25 % of amplitude between block sizes with the 8-tap read).
 
-1. Chirp scaling [CumWong2005, eq. 7.30]: x exp(j pi Km a (tau - tau_r)^2), a = D_ref / D - 1,
+1. Chirp scaling [CumWong2005, eq. 7.30]: x exp(j pi Km a (tau - tau_r)^2), a = D_ref / D - 1 (a few
+   1e-4 across Radarsat-1's band, a few per cent at 40 degrees airborne),
    tau_r = 2 R_ref / (c D). Completing the square, S1 becomes a chirp of rate K' = Km (1 + a)
    centred at tau_s = tau_r + (tau_t - tau_r) / (1 + a), times exp(j theta), theta = pi Km a / (1 + a)
    (tau_t - tau_r)^2: every target now migrates like the reference, tau_s - tau_r = 2 (R0 - R_ref) /
@@ -210,6 +214,7 @@ class CsaPlan:
     n_fft_r: int
     r_ref: float
     c_ref: float
+    d_ref: float
     wtab_r: np.ndarray
     wtab_a: np.ndarray
     table: np.ndarray
@@ -232,15 +237,15 @@ def _d(f, v, wavelength):
     return np.sqrt(1.0 - (wavelength * f / (2.0 * v)) ** 2)
 
 
-def row_parameters(f_bin: np.ndarray, prf: float, fdc_ref: float, v_ref: float, r_ref: float, radar,
+def row_parameters(f_bin: np.ndarray, prf: float, fdc_ref: float, v_ref: float, r_ref: float, d_ref: float, radar,
                    src: bool) -> dict[str, np.ndarray]:
-    """Per azimuth-frequency row of the block: absolute f (Hz), D, D_ref, Km (Hz/s), scaling a,
-    tau_r (s) and the bulk shift Delta_b (s) of the module docstring."""
+    """Per azimuth-frequency row of the block: absolute f (Hz, wrapped around the block's fdc_ref), D,
+    D_ref (given: the plan's), Km (Hz/s), scaling a, tau_r (s) and the bulk shift Delta_b (s) of the
+    module docstring."""
     lam = C / radar.carrier_frequency_hz
     off = f_bin - fdc_ref
     f = fdc_ref + off - prf * np.floor(off / prf + 0.5)
     d = _d(f, v_ref, lam)
-    d_ref = float(_d(fdc_ref, v_ref, lam))
     z = inverse_src_rate(f, r_ref, v_ref, radar.carrier_frequency_hz) if src else np.zeros_like(f)
     km = 1.0 / (1.0 / radar.chirp_rate_hz_per_s - z)
     a = d_ref / d - 1.0
@@ -397,10 +402,14 @@ class ChirpScaling(RangeDoppler):
         b_r = chirp_band(radar) * k.range_bandwidth_fraction
         lam = grid.wavelength
         smax, shift_max, band_max = 0.0, 0.0, 0.0
+        # D_ref, the migration every target is scaled to, is the plan's (the scene-centre model at R_ref):
+        # with a block's own, the range read of step 3 would sit at block-dependent fractions of a sample
+        q_mid = model.at_columns(0.5 * (float(t_raw[0]) + float(t_raw[-1])), nr)
+        d_ref = float(_d(*(float(np.interp(c_ref, np.arange(nr), q_mid[n])) for n in ("fdc", "v")), lam))
         for q in blocks:
             fdc_r, v_r = (float(np.interp(c_ref, np.arange(nr), q[n])) for n in ("fdc", "v"))
             f = fdc_r + np.linspace(-0.5, 0.5, 65) * grid.ba
-            a = _d(fdc_r, v_r, lam) / _d(f, v_r, lam) - 1.0
+            a = d_ref / _d(f, v_r, lam) - 1.0
             smax = max(smax, float(np.max(np.abs(a))))
             band_max = max(band_max, float(np.max(b_r / _d(f, v_r, lam))))
             # content moves by rho (D(f)/D_ref - 1) (step 2) and by the per-column read (step 3)
@@ -421,7 +430,7 @@ class ChirpScaling(RangeDoppler):
         rdt = np.float32 if k.precision == "single" else np.float64
         return CsaPlan(raw=raw, options=k, terrain=terrain, grid=grid, model=model, output_shape=(n_lines, nr),
                        n_blocks=n_blocks, n_valid=n_valid, n_fft_az=n_fft_az, n_fft_r=n_fft_r, r_ref=r_ref,
-                       c_ref=c_ref, wtab_r=window_table(k.range_window), wtab_a=window_table(k.azimuth_window),
+                       c_ref=c_ref, d_ref=d_ref, wtab_r=window_table(k.range_window), wtab_a=window_table(k.azimuth_window),
                        table=table_for(k.interpolator)[1].astype(rdt), f_bin=sfft.fftfreq(n_fft_az, 1.0 / grid.prf),
                        shift_table=table_for(SHIFT_INTERPOLATOR)[1].astype(rdt), gain=raw.line_gain(),
                        block_time=block_time, block=blocks, warnings=msgs, replica=replica, scaling_max=smax,
@@ -454,8 +463,8 @@ class ChirpScaling(RangeDoppler):
         q = plan.block[b]
         cols = np.arange(nr)
         fdc_r, v_r = (float(np.interp(plan.c_ref, cols, q[n])) for n in ("fdc", "v"))
-        rp = row_parameters(plan.f_bin, g.prf, fdc_r, v_r, plan.r_ref, radar, k.src)
-        pos = column_positions(g.ranges, q["fdc"], q["v"], v_r, float(rp["d_ref"][0]), g.wavelength)
+        rp = row_parameters(plan.f_bin, g.prf, fdc_r, v_r, plan.r_ref, plan.d_ref, radar, k.src)
+        pos = column_positions(g.ranges, q["fdc"], q["v"], v_r, plan.d_ref, g.wavelength)
         factor = k.range_oversample
         dr = float(g.ranges[1] - g.ranges[0])
         pos = (pos - float(g.ranges[0])) / dr * factor

@@ -160,15 +160,20 @@ def _deskew(chip, carrier, lines_per_col, c0):
     return np.fft.ifft(np.fft.fft(chip, axis=0) * np.exp(2j * np.pi * fa[:, None] * sh[None, :]), axis=0)
 
 
-def _airborne_case(lam, deg, prf, ba, half=40):
+def _airborne_case(lam, deg, prf, ba, half=40, csa_at_mid_swath=False):
+    """rd and csa (and, asked for, csa with R_ref at mid-swath: "csa_mid") against BP (module docstring)."""
     raw, (r0, eta0), dop, fdc = _airborne(lam, deg, prf, ba)
     dr = C / (2 * raw.radar.range_sampling_rate_hz)
+    runs = [("rd", focus_rd, {}), ("csa", focus_csa, {})]
+    if csa_at_mid_swath:
+        mid = raw.radar.first_range_m + 0.5 * (raw.echo.shape[1] - 1) * dr
+        runs.append(("csa_mid", focus_csa, {"reference_range_m": mid}))
     out = {}
-    for name, fn in (("rd", focus_rd), ("csa", focus_csa)):
+    for name, fn, kw in runs:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the scene ends before far-range lines see their aperture
             slc = fn(raw, dop, range_window="rect", azimuth_window="rect", range_bandwidth_fraction=0.9,
-                     azimuth_bandwidth_hz=ba)
+                     azimuth_bandwidth_hz=ba, **kw)
         row = float(np.interp(eta0, slc.azimuth_time, np.arange(slc.azimuth_time.size)))
         col = (r0 - slc.slant_range[0]) / dr
         r, c = int(round(row)), int(round(col))
@@ -183,7 +188,7 @@ def _airborne_case(lam, deg, prf, ba, half=40):
     mb = point_target_metrics(_deskew(bp, fdc / prf, skew, col - cols[0]), row - rows[0], col - cols[0], half=half,
                               azimuth_carrier=fdc / prf)
     res = {}
-    for name in ("rd", "csa"):
+    for name in (n for n, _, _ in runs):
         a = out[name]
         p = _peak2d(a, fdc / prf)
         m = point_target_metrics(_deskew(a, fdc / prf, skew, col - cols[0]), row - rows[0], col - cols[0],
@@ -284,7 +289,7 @@ def test_l_band_three_second_aperture():
     (5300 lines), 63 m of migration, a centroid of -1.2 PRF. Bars of the spaceborne scenes."""
     lam, prf, ba, fdc = C / 1.27e9, 1800.0, 1440.0, -1.2 * 1800.0
     s = -fdc * lam / (2 * V)
-    eta0 = 3.2 + 0.37 / prf - R0 * s / np.sqrt(1 - s * s) / V
+    eta0 = 3200 / prf + 0.37 / prf - R0 * s / np.sqrt(1 - s * s) / V
     raw = scene([(R0, eta0, 1.0)], n_lines=6400, n_samples=768, prf=prf, wavelength=lam, fdc=fdc,
                 exposure_bw_hz=1560.0)
     slc = focus_csa(raw, GeometricDoppler(V, s, lam), range_window="rect", azimuth_window="rect",
