@@ -260,38 +260,82 @@ def column_positions(r0: np.ndarray, fdc: np.ndarray, v: np.ndarray, v_ref: floa
     return r0 * _d(fdc, v_ref, wavelength) / (_d(fdc, v, wavelength) * d_ref)
 
 
+SEGMENT = 64  # samples per exactly restarted phasor recurrence (drift below 1e-12 rad, as rangecomp)
+SPAN = 32  # columns of the azimuth kernel between exact phases (the model grid's GRID_SAMPLES)
+SPAN_TOL_RAD = 1e-3  # largest curvature error of the linear phase over a span; rows above: exact
+
+
 @njit(nogil=True, cache=True, fastmath=True)
 def chirp_scale(x, nr, q2, tau_r, tau0, dtau):
-    """x[k, m] *= exp(j q2[k] (tau0 + m dtau - tau_r[k])^2) for m < nr, in place (q2 = pi Km a)."""
+    """x[k, m] *= exp(j q2[k] (tau0 + m dtau - tau_r[k])^2) for m < nr, in place (q2 = pi Km a).
+
+    The phase is quadratic in m: a second-order phasor recurrence (two complex multiplies a sample),
+    restarted exactly every SEGMENT samples."""
     for k in range(x.shape[0]):
         if q2[k] == 0.0:
             continue
-        for m in range(nr):
+        m = 0
+        while m < nr:
+            e = min(nr, m + SEGMENT)
             u = tau0 + m * dtau - tau_r[k]
             ph = q2[k] * u * u
-            x[k, m] *= complex(np.cos(ph), np.sin(ph))
+            cur = complex(np.cos(ph), np.sin(ph))
+            d1 = q2[k] * (2.0 * u * dtau + dtau * dtau)
+            step = complex(np.cos(d1), np.sin(d1))
+            d2 = 2.0 * q2[k] * dtau * dtau
+            curv = complex(np.cos(d2), np.sin(d2))
+            for q in range(m, e):
+                x[k, q] *= cur
+                cur *= step
+                step *= curv
+            m = e
 
 
 @njit(nogil=True, cache=True, fastmath=True)
 def csa_range_filter(x, f_tau, inv_band, c2, c1, c0, gain, wtab, out):
     """out[k, j(m)] = x[k, m] W(f_tau[m] inv_band[k]) gain[k] exp(j (c2[k] f^2 + c1[k] f + c0)),
     f = f_tau[m], with the zero-padding layout of :func:`sarcli.focus.rangecomp.apply_range_filter_2d`
-    (out has n_out >= n_f columns, the negative half moved to the end, the gap zeroed)."""
+    (out has n_out >= n_f columns, the negative half moved to the end, the gap zeroed). The phase is
+    quadratic in m on each half of the FFT axis: a phasor recurrence restarted every SEGMENT samples."""
     na, nf = x.shape
     half = (nf + 1) // 2
     gap = out.shape[1] - nf
     for k in range(na):
         for q in range(half, half + gap):
             out[k, q] = 0.0
-        for m in range(nf):
-            j = m if m < half else m + gap
+        m = 0
+        while m < nf:
+            e = min(nf, m + SEGMENT)
+            if m < half < e:
+                e = half  # the frequency axis jumps from +fs/2 to -fs/2 there
             f = f_tau[m]
-            u = f * inv_band[k]
-            if u < -0.5 or u > 0.5:
-                out[k, j] = 0.0
-                continue
             ph = (c2[k] * f + c1[k]) * f + c0
-            out[k, j] = x[k, m] * (table_lookup(wtab, u) * gain[k] * complex(np.cos(ph), np.sin(ph)))
+            cur = complex(np.cos(ph), np.sin(ph))
+            df = f_tau[m + 1] - f if m + 1 < nf else 0.0
+            d1 = c2[k] * (2.0 * f * df + df * df) + c1[k] * df
+            step = complex(np.cos(d1), np.sin(d1))
+            d2 = 2.0 * c2[k] * df * df
+            curv = complex(np.cos(d2), np.sin(d2))
+            for q in range(m, e):
+                j = q if q < half else q + gap
+                u = f_tau[q] * inv_band[k]
+                if u < -0.5 or u > 0.5:
+                    out[k, j] = 0.0
+                else:
+                    out[k, j] = x[k, q] * (table_lookup(wtab, u) * gain[k] * cur)
+                cur *= step
+                step *= curv
+            m = e
+
+
+@njit(inline="always", fastmath=True)
+def _azimuth_phase(i, f, psh, g, tau_k, r0, v, dt, ph0, wavelength):
+    """Phase of output column i in the row of absolute frequency f (see :func:`csa_azimuth`)."""
+    x = (wavelength * f / (2.0 * v[i])) ** 2
+    d = np.sqrt(1.0 - x)
+    dm1 = -x / (1.0 + d)
+    e = 2.0 * r0[i] / (299792458.0 * d) - tau_k
+    return 4.0 * np.pi * r0[i] * dm1 / wavelength + psh - 2.0 * np.pi * f * dt[i] + ph0[i] - g * e * e
 
 
 @njit(nogil=True, cache=True, fastmath=True)
@@ -301,7 +345,13 @@ def csa_azimuth(up, f_row, f_bin, pos, r0, v, fdc, dt, ph0, km, a, tau_r, wavele
     ``up``: nearest, linear or the windowed-sinc ``table``), times the azimuth window
     W((f - fdc_i) / Ba), exp(j 4 pi R0_i (D(f, V_i) - 1) / lam + j pi/4 - j theta) and RD's shift, dt and
     ph0 terms; theta = pi Km a / (1 + a) (2 R0_i / (c D(f, V_i)) - tau_r)^2, f = f_row[k]. Writes
-    out[k, i] (float64 geometry and phase)."""
+    out[k, i] (float64 geometry and phase).
+
+    Speed: the phase is exact every SPAN columns and advanced by a fixed rotation in between (as
+    :func:`sarcli.focus.rcmc.rcmc_azimuth`); the residual theta is quadratic in R0, so a row whose
+    curvature error over a span, |theta''| SPAN^2 / 8 with theta'' = 2 |g| (2 dr / (c D))^2, exceeds
+    SPAN_TOL_RAD (airborne high squint) is computed column by column. The azimuth filter's own curvature
+    (V_i, dt_i and ph0_i are linear between the model grid's columns) is RD's."""
     na = up.shape[0]
     nrow = up.shape[1]
     nout = r0.shape[0]
@@ -309,41 +359,63 @@ def csa_azimuth(up, f_row, f_bin, pos, r0, v, fdc, dt, ph0, km, a, tau_r, wavele
     taps = table.shape[1]
     k0 = taps // 2 - 1
     zero = np.zeros(1, up.dtype)[0]
+    dr = (r0[nout - 1] - r0[0]) / max(nout - 1, 1)
     for k in range(na):
         f = f_row[k]
         psh = -2.0 * np.pi * f_bin[k] * shift / prf + 0.25 * np.pi
         g = np.pi * km[k] * a[k] / (1.0 + a[k])
-        for i in range(nout):
-            u = (f - fdc[i]) / ba
-            if u < -0.5 or u > 0.5:
-                out[k, i] = 0.0
-                continue
-            x = (wavelength * f / (2.0 * v[i])) ** 2
-            d = np.sqrt(1.0 - x)
-            dm1 = -x / (1.0 + d)
-            e = 2.0 * r0[i] / (299792458.0 * d) - tau_r[k]
-            ph = 4.0 * np.pi * r0[i] * dm1 / wavelength + psh - 2.0 * np.pi * f * dt[i] + ph0[i] - g * e * e
-            p = pos[i]
-            val = zero
-            if kind == 2:
-                j = int(np.floor(p))
-                jp = int((p - j) * nph + 0.5)
-                b = j - k0
-                for t in range(taps):
-                    if 0 <= b + t < nrow:
-                        val += up[k, b + t] * table[jp, t]
-            elif kind == 1:
-                j = int(np.floor(p))
-                mu = p - j
-                if 0 <= j < nrow:
-                    val += up[k, j] * (1.0 - mu)
-                if 0 <= j + 1 < nrow:
-                    val += up[k, j + 1] * mu
-            else:
-                j = int(np.floor(p + 0.5))
-                if 0 <= j < nrow:
-                    val = up[k, j]
-            out[k, i] = val * (table_lookup(wtab, u) * complex(np.cos(ph), np.sin(ph)))
+        dmin = np.sqrt(1.0 - (wavelength * f / (2.0 * v[0])) ** 2)
+        curv = 2.0 * abs(g) * (2.0 * dr / (299792458.0 * dmin)) ** 2 * SPAN * SPAN / 8.0
+        exact = curv > SPAN_TOL_RAD
+        i0 = 0
+        while i0 < nout:
+            i1 = min(i0 + SPAN, nout - 1)
+            n = i1 - i0
+            stop = i1 if i1 < nout - 1 else nout
+            cur = complex(1.0, 0.0)
+            rot = complex(1.0, 0.0)
+            if not exact and n > 0:
+                q0 = _azimuth_phase(i0, f, psh, g, tau_r[k], r0, v, dt, ph0, wavelength)
+                q1 = _azimuth_phase(i1, f, psh, g, tau_r[k], r0, v, dt, ph0, wavelength)
+                cur = complex(np.cos(q0), np.sin(q0))
+                rot = complex(np.cos((q1 - q0) / n), np.sin((q1 - q0) / n))
+            for i in range(i0, stop):
+                if exact or n == 0:
+                    q = _azimuth_phase(i, f, psh, g, tau_r[k], r0, v, dt, ph0, wavelength)
+                    ph_c = complex(np.cos(q), np.sin(q))
+                else:
+                    ph_c = cur
+                    cur *= rot
+                u = (f - fdc[i]) / ba
+                if u < -0.5 or u > 0.5:
+                    out[k, i] = 0.0
+                    continue
+                p = pos[i]
+                val = zero
+                if kind == 2:
+                    j = int(np.floor(p))
+                    jp = int((p - j) * nph + 0.5)
+                    b = j - k0
+                    if b >= 0 and b + taps <= nrow:
+                        for t in range(taps):
+                            val += up[k, b + t] * table[jp, t]
+                    else:
+                        for t in range(taps):
+                            if 0 <= b + t < nrow:
+                                val += up[k, b + t] * table[jp, t]
+                elif kind == 1:
+                    j = int(np.floor(p))
+                    mu = p - j
+                    if 0 <= j < nrow:
+                        val += up[k, j] * (1.0 - mu)
+                    if 0 <= j + 1 < nrow:
+                        val += up[k, j + 1] * mu
+                else:
+                    j = int(np.floor(p + 0.5))
+                    if 0 <= j < nrow:
+                        val = up[k, j]
+                out[k, i] = val * (table_lookup(wtab, u) * ph_c)
+            i0 = stop
 
 
 class ChirpScaling(RangeDoppler):
