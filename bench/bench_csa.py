@@ -83,7 +83,8 @@ def main() -> None:
           f"({tm['ratio_to_2fft2']['rd']:.2f} x), csa {tm['seconds']['csa']:.3f} s "
           f"({tm['ratio_to_2fft2']['csa']:.2f} x): csa / rd = {tm['csa_over_rd']:.2f}\n",
           "## Spaceborne point target (rect), vs window theory and truth\n",
-          markdown_table(["centroid (PRF)", "alg", "IRW rg", "IRW az", "PSLR rg dB", "PSLR az dB", "pos px", "phase rad"],
+          markdown_table(["centroid (PRF)", "alg", "IRW rg", "IRW az", "PSLR rg dB", "PSLR az dB", "pos px",
+                          "phase rad"],
                          [[f"{r['fdc_prf']:.1f}", r["algorithm"], f"{100 * r['irw_range_rel']:+.2f} %",
                            f"{100 * r['irw_azimuth_rel']:+.2f} %", f"{r['pslr_range_db']:.2f}",
                            f"{r['pslr_azimuth_db']:.2f}", f"{r['position_px']:.4f}", f"{r['phase_rad']:+.4f}"]

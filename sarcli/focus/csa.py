@@ -502,7 +502,8 @@ class ChirpScaling(RangeDoppler):
         rdt = np.float32 if k.precision == "single" else np.float64
         return CsaPlan(raw=raw, options=k, terrain=terrain, grid=grid, model=model, output_shape=(n_lines, nr),
                        n_blocks=n_blocks, n_valid=n_valid, n_fft_az=n_fft_az, n_fft_r=n_fft_r, r_ref=r_ref,
-                       c_ref=c_ref, d_ref=d_ref, wtab_r=window_table(k.range_window), wtab_a=window_table(k.azimuth_window),
+                       c_ref=c_ref, d_ref=d_ref, wtab_r=window_table(k.range_window),
+                       wtab_a=window_table(k.azimuth_window),
                        table=table_for(k.interpolator)[1].astype(rdt), f_bin=sfft.fftfreq(n_fft_az, 1.0 / grid.prf),
                        shift_table=table_for(SHIFT_INTERPOLATOR)[1].astype(rdt), gain=raw.line_gain(),
                        block_time=block_time, block=blocks, warnings=msgs, replica=replica, scaling_max=smax,

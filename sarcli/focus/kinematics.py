@@ -49,6 +49,7 @@ def velocity_and_squint(fdc_hz: np.ndarray, fr_hz_per_s: np.ndarray, r0_m: np.nd
         raise SarcliError(f"Doppler rate {fr.max():.3g} Hz/s is too close to zero to focus (|fr| < {fr_min:.2g})")
     cos3 = np.ones_like(fr * r0)
     v_old = np.zeros_like(cos3)
+    s = np.zeros_like(cos3)
     for _ in range(max_iterations):
         v = np.sqrt(-fr * wavelength_m * r0 / (2.0 * cos3))
         if np.all(np.abs(v - v_old) <= 1e-13 * v):

@@ -102,7 +102,8 @@ def focused(rs1_raws):
         warnings.simplefilter("ignore")
         out = {"raw": raw, "rd": focus_rd(raw, dop), "csa": focus_csa(raw, dop),
                "csa_rect": focus_csa(raw, dop, range_window="rect", azimuth_window="rect")}
-    out["book"] = book_csa(raw.echo.astype(np.complex128), raw.radar, FDC, VR, out["csa_rect"].parameters["azimuth_bandwidth_hz"])
+    band = out["csa_rect"].parameters["azimuth_bandwidth_hz"]
+    out["book"] = book_csa(raw.echo.astype(np.complex128), raw.radar, FDC, VR, band)
     return out
 
 
