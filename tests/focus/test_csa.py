@@ -515,3 +515,44 @@ def test_csa_azimuth_kernel_matches_numpy(g_scale):
     err = np.abs(out - want) / np.maximum(np.abs(want), 1e-30)
     ok = np.abs(want) > 0
     assert np.max(err[ok]) < SPAN_TOL_RAD + 2e-6 * 50, np.max(err[ok])
+
+
+@pytest.mark.slow
+def test_orbit_scene_with_the_estimated_doppler():
+    """The demo scene (samples/rs1_point.toml: rotating Earth, antenna pattern, 4-bit data, -5.3 PRF) with
+    the Doppler estimated by sarcli.doppler (V per range and time from its model, orbit-timing
+    correction): RD's bars of test_block_invariance -- blocks of 2048 and 4096 lines agree to 0.01 rad
+    and 0.1 %, the peak phase within 0.05 rad of -4 pi R0 / lam + the target's own phase, the azimuth
+    position within 0.01 line of the truth."""
+    from pathlib import Path
+
+    from sarcli.doppler.api import estimate_doppler
+    from sarcli.focus.quality import truth_targets
+    from sarcli.sim.scene import load_scene
+    from sarcli.sim.stripmap import simulate
+
+    from .test_block_invariance import carrier
+
+    raw = simulate(load_scene(Path(__file__).resolve().parents[2] / "samples" / "rs1_point.toml"))
+    dop = estimate_doppler(raw)
+    lam = raw.radar.wavelength_m
+    tg = raw.truth["targets"]
+    own = np.angle(tg["reflectivity_re"] + 1j * tg["reflectivity_im"])
+    res, layouts = {}, set()
+    for bl in (2048, 4096):
+        slc = focus_csa(raw, dop, block_lines=bl)
+        layouts.add(slc.parameters["n_blocks"])
+        rows = []
+        for tz, r0 in truth_targets(raw.truth):
+            row = (tz - slc.azimuth_time[0]) * slc.prf_hz
+            col = (r0 - slc.slant_range[0]) / slc.range_spacing_m
+            m = point_target_metrics(slc.image, row, col, azimuth_carrier=carrier(slc, row, col))
+            rows.append((m["peak_amplitude"], m["peak_phase_rad"], r0, m["row"] - row))
+        res[bl] = np.array(rows)
+    a, b = res[2048], res[4096]
+    assert len(layouts) == 2  # two different block layouts
+    assert np.max(np.abs(np.angle(np.exp(1j * (a[:, 1] - b[:, 1]))))) < 0.01
+    assert np.max(np.abs(a[:, 0] / b[:, 0] - 1)) < 1e-3
+    for m in res.values():
+        assert np.max(np.abs(np.angle(np.exp(1j * (m[:, 1] + 4 * np.pi * m[:, 2] / lam - own))))) < 0.05, m
+        assert np.max(np.abs(m[:, 3])) < 0.01, m[:, 3]

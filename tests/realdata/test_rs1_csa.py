@@ -93,11 +93,15 @@ def stats(img):
     return i.std() / i.mean(), float(-np.sum(p[p > 0] * np.log(p[p > 0])))
 
 
+def _published(raw):
+    lam = raw.radar.wavelength_m
+    return GeometricDoppler(VR, -FDC * lam / (2 * VR), lam)
+
+
 @pytest.fixture(scope="module")
 def focused(rs1_raws):
     raw = rs1_raws["coal_ferry_terminals"]
-    lam = raw.radar.wavelength_m
-    dop = GeometricDoppler(VR, -FDC * lam / (2 * VR), lam)
+    dop = _published(raw)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = {"raw": raw, "rd": focus_rd(raw, dop), "csa": focus_csa(raw, dop),
@@ -108,10 +112,19 @@ def focused(rs1_raws):
 
 
 @pytest.mark.slow
-def test_csa_and_rd_agree_on_a_real_block(focused):
-    """Same Doppler, default windows: contrast and entropy within 2 % (measured: see docs/focusing.md),
-    the images register within 0.1 pixel, and their amplitudes correlate above 0.95."""
-    rd, csa = focused["rd"], focused["csa"]
+@pytest.mark.parametrize("name", ["coal_ferry_terminals", "block1"])
+def test_csa_and_rd_agree_on_a_real_block(focused, rs1_raws, name):
+    """Same Doppler, default windows: contrast and entropy within 2 % (the issue's "a few per cent";
+    measured: contrast 22.56 / 22.56 and 45.09 / 45.27, entropy within 0.06 %), the images register
+    within 0.1 pixel (measured 0.00 in a 256 x 256 window at mid-scene), and the amplitudes of the fully
+    focused lines correlate above 0.99 (measured 0.9996 on both blocks)."""
+    if name == "coal_ferry_terminals":
+        rd, csa = focused["rd"], focused["csa"]
+    else:
+        raw = rs1_raws[name]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rd, csa = focus_rd(raw, _published(raw)), focus_csa(raw, _published(raw))
     lo, hi = max(rd.first_full_line, csa.first_full_line), min(rd.last_full_line, csa.last_full_line) + 1
     a, b = rd.image[lo:hi], csa.image[lo:hi]
     (c_rd, e_rd), (c_csa, e_csa) = stats(a), stats(b)
@@ -121,7 +134,7 @@ def test_csa_and_rd_agree_on_a_real_block(focused):
     wb = csa.image[mid_r - 128:mid_r + 128, mid_c - 128:mid_c + 128]
     dr, dc = shift_between(wa, wb)
     assert abs(dr) < 0.1 and abs(dc) < 0.1, (dr, dc)
-    assert np.corrcoef(np.abs(a).ravel(), np.abs(b).ravel())[0, 1] > 0.95
+    assert np.corrcoef(np.abs(a).ravel(), np.abs(b).ravel())[0, 1] > 0.99
 
 
 @pytest.mark.slow
