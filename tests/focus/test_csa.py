@@ -556,3 +556,21 @@ def test_orbit_scene_with_the_estimated_doppler():
     for m in res.values():
         assert np.max(np.abs(np.angle(np.exp(1j * (m[:, 1] + 4 * np.pi * m[:, 2] / lam - own))))) < 0.05, m
         assert np.max(np.abs(m[:, 3])) < 0.01, m[:, 3]
+
+
+def test_range_band_beyond_the_sampling_rate_on_the_zero_doppler_grid_warns():
+    """At 40 degrees the R0 grid samples the range IRF compressed by D = cos(40) = 0.77: a 100 MHz band
+    needs more than 131 MHz of sampling there (RD's grid has the same limit); at 120 MHz, a warning."""
+    from sarcli.focus.base import make_plan
+    from sarcli.focus.csa import CSA
+
+    s = np.sin(np.radians(40.0))
+    lam = C / 9.6e9
+    for fs, warns in ((120e6, True), (150e6, False)):
+        raw = scene([], n_lines=1200, n_samples=1100, prf=400.0, fs=fs, chirp_rate=-5e13, pulse=2e-6,
+                    wavelength=lam, velocity=100.0, r_first=1900.0)
+        with warnings.catch_warnings(record=True) as rec:
+            warnings.simplefilter("always")
+            make_plan(CSA, raw, raw.echo.shape, GeometricDoppler(100.0, s, lam),
+                      {"azimuth_bandwidth_hz": 300.0, "range_bandwidth_fraction": 1.0}, None)
+        assert any("range aliasing" in str(w.message) for w in rec) == warns, fs
