@@ -49,17 +49,41 @@ def velocity_and_squint(fdc_hz: np.ndarray, fr_hz_per_s: np.ndarray, r0_m: np.nd
         raise SarcliError(f"Doppler rate {fr.max():.3g} Hz/s is too close to zero to focus (|fr| < {fr_min:.2g})")
     cos3 = np.ones_like(fr * r0)
     v_old = np.zeros_like(cos3)
+    s = np.zeros_like(cos3)
     for _ in range(max_iterations):
         v = np.sqrt(-fr * wavelength_m * r0 / (2.0 * cos3))
         if np.all(np.abs(v - v_old) <= 1e-13 * v):
-            break
+            return v, s
         v_old = v
         s = -fdc * wavelength_m / (2.0 * v)
         if np.any(np.abs(s) > np.sin(np.radians(60.0))):
-            raise SarcliError(f"Doppler centroid {np.abs(fdc).max():.4g} Hz implies a squint beyond 60 deg:"
-                              " check the centroid and its ambiguity")
+            break
         cos3 = (1.0 - s * s) ** 1.5
+    # the fixed point diverges beyond ~39 deg of squint (its slope is about 1.5 tan^2(theta)): solve the
+    # cubic instead (airborne high squint)
+    v, s = _velocity_cubic(fdc, fr, r0, wavelength_m)
+    if np.any(np.abs(s) > np.sin(np.radians(60.0))):
+        raise SarcliError(f"Doppler centroid {np.abs(fdc).max():.4g} Hz implies a squint beyond 60 deg:"
+                          " check the centroid and its ambiguity")
     return v, s
+
+
+def _velocity_cubic(fdc: np.ndarray, fr: np.ndarray, r0: np.ndarray, wavelength_m: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """(V, sin theta) from u = V^2: with A = -fr lam R0 / 2 = u cos^3(theta) and B = (fdc lam / 2)^2 =
+    u sin^2(theta), w = u - B solves g(w) = w^3 - A^2 w - A^2 B = 0, whose one positive root Newton
+    reaches monotonically from w0 = A + (A^2 B)^(1/3) (g convex for w > A / sqrt(3), g(w0) >= 0)."""
+    a = -fr * wavelength_m * r0 / 2.0
+    b = (fdc * wavelength_m / 2.0) ** 2
+    a, b = np.broadcast_arrays(a, b)
+    w = a + np.cbrt(a * a * b)
+    for _ in range(100):
+        step = (w**3 - a * a * w - a * a * b) / (3.0 * w * w - a * a)
+        w = w - step
+        if np.all(np.abs(step) <= 1e-15 * w):
+            break
+    v = np.sqrt(w + b)
+    return v, -fdc * wavelength_m / (2.0 * v)
 
 
 def migration_factor(f_hz: np.ndarray, v_mps: np.ndarray, wavelength_m: float) -> np.ndarray:
