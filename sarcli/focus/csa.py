@@ -104,7 +104,6 @@ from sarcli.focus.rda import (
     CHUNK,
     RANGE_GUARD,
     SHIFT_INTERPOLATOR,
-    SHIFT_TOL_LINES,
     ModelGrid,
     OutputGrid,
     RangeDoppler,
@@ -113,8 +112,6 @@ from sarcli.focus.rda import (
     _fft_inplace,
     _n_threads,
     _pooled,
-    apply_line_phase,
-    correct_lines,
     model_grid,
     plan_grid,
     smooth_len,
@@ -594,18 +591,7 @@ class ChirpScaling(RangeDoppler):
         t0 = time.perf_counter()
         _fft_inplace(img, 0, True, k.workers)
         _add(tm, "azimuth_ifft_s", t0)
-        res = img[g.pad:g.pad + (e - s)]
-        t0 = time.perf_counter()
-        lines_c, phi, mu = self.line_corrections(plan, b)  # type: ignore[arg-type]  # RD's attributes
-        if np.max(np.abs(mu)) >= SHIFT_TOL_LINES:
-            shifted = np.empty((e - s, nr), img.dtype)
-            correct_lines(img, g.pad, s, shifted, lines_c, plan.model.columns, phi, mu, q["fdc"] / g.prf,
-                          plan.shift_table)
-            res = shifted
-        elif np.any(phi != 0.0):
-            apply_line_phase(res, s, lines_c, plan.model.columns, phi)
-        _add(tm, "line_correction_s", t0)
-        return np.ascontiguousarray(res, np.complex64)
+        return self._correct_block(plan, b, img)  # type: ignore[arg-type]  # RD's attributes
 
     def finish(self, plan: CsaPlan) -> SLC:  # type: ignore[override]
         g, raw, k = plan.grid, plan.raw, plan.options
