@@ -117,6 +117,7 @@ from sarcli.focus.rda import (
     smooth_len,
 )
 from sarcli.focus.windows import parse_window, table_lookup, window_table
+from sarcli.gpu.device import check_device
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import ConstantHeight, Terrain
@@ -137,7 +138,8 @@ class CsaOptions:
     read of step 3 (nearest, linear, sinc4/8/16); range_oversample: 1 or 2, Fourier upsampling before it
     (as RD's rcmc_oversample); precision: "single" (complex64) or "double"; block_lines: azimuth FFT
     length per block (memory; the image does not depend on it); orbit_timing: exact zero-Doppler timing
-    with an Earth orbit (:func:`sarcli.focus.rda.orbit_time_correction`); workers: threads.
+    with an Earth orbit (:func:`sarcli.focus.rda.orbit_time_correction`); workers: threads; device: cpu, or
+    cuda (steps 1-4 on the GPU, :mod:`sarcli.gpu.csa_xp`).
     """
 
     range_window: str = "kaiser:2.5"
@@ -152,8 +154,10 @@ class CsaOptions:
     block_lines: int = 4096
     orbit_timing: bool = True
     workers: int = -1
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
         parse_window(self.range_window)
         parse_window(self.azimuth_window)
         parse_interpolator(self.interpolator)
@@ -421,6 +425,36 @@ def csa_azimuth(up, f_row, f_bin, pos, r0, v, fdc, dt, ph0, km, a, tau_r, wavele
             i0 = stop
 
 
+def block_parameters(plan: CsaPlan, b: int) -> dict[str, Any]:
+    """What steps 1-4 of block ``b`` need besides the echo, computed on the host (float64), for the CPU
+    and the GPU path alike: ``rows`` (:func:`row_parameters` at the reference column), ``pos`` (each
+    column's read position in upsampled samples), the chirp-scaling phase q2 = pi Km a, the range filter's
+    phase coefficients c2, c1, c0, band and gain per row, ``f_tau`` (range FFT frequencies), ``tau0``,
+    ``dtau`` (s) and ``active`` (rows inside the processed band at some column)."""
+    k, g, radar = plan.options, plan.grid, plan.raw.radar
+    nr = plan.output_shape[1]
+    q = plan.block[b]
+    cols = np.arange(nr)
+    fdc_r, v_r = (float(np.interp(plan.c_ref, cols, q[n])) for n in ("fdc", "v"))
+    rp = row_parameters(plan.f_bin, g.prf, fdc_r, v_r, plan.r_ref, plan.d_ref, radar, k.src)
+    pos = column_positions(g.ranges, q["fdc"], q["v"], v_r, plan.d_ref, g.wavelength)
+    factor = k.range_oversample
+    dr = float(g.ranges[1] - g.ranges[0])
+    k2 = rp["km"] * (1.0 + rp["a"])
+    # rows outside the processed band at every column are zero: skipped
+    offs = rp["f"][:, None] - q["fdc"][None, ::16]
+    return {"rows": rp, "pos": (pos - float(g.ranges[0])) / dr * factor,
+            "inv_band": 1.0 / (chirp_band(radar) * k.range_bandwidth_fraction * (1.0 + rp["a"])),
+            # 1 / (T sqrt|K'|): a unit chirp compresses to ~1 (module docstring); x factor: the IFFT of the
+            # zero-padded spectrum divides by factor x L
+            "gain": factor / (radar.pulse_length_s * np.sqrt(np.abs(k2))),
+            "f_tau": sfft.fftfreq(plan.n_fft_r, 1.0 / radar.range_sampling_rate_hz),
+            "tau0": 2.0 * float(g.ranges[0]) / C, "dtau": 1.0 / radar.range_sampling_rate_hz,
+            "active": np.any(np.abs(offs) <= 0.5 * g.ba * (1.0 + 1e-9), axis=1),
+            "q2": np.pi * rp["km"] * rp["a"], "c2": np.pi / k2, "c1": 2.0 * np.pi * rp["delta_b"],
+            "c0": -0.25 * np.pi * np.sign(radar.chirp_rate_hz_per_s)}
+
+
 class ChirpScaling(RangeDoppler):
     """The CSA as a focuser (:mod:`sarcli.focus.base`): ``sarcli focus --algorithm csa``. It shares RD's
     output grid, model grid and per-line corrections (:meth:`RangeDoppler.line_corrections`)."""
@@ -514,8 +548,7 @@ class ChirpScaling(RangeDoppler):
 
     def focus_block(self, plan: CsaPlan, b: int,  # type: ignore[override]
                     read_lines: Callable[[int, int], np.ndarray]) -> np.ndarray:
-        k, g, raw = plan.options, plan.grid, plan.raw
-        radar = raw.radar
+        k, g = plan.options, plan.grid
         n_lines, nr = plan.output_shape
         s, e = plan.block_rows(b)
         a, z = max(0, s - g.pad), min(n_lines, e + g.pad)
@@ -525,38 +558,40 @@ class ChirpScaling(RangeDoppler):
         _add(tm, "io_s", t0)
         if data.shape != (z - a, nr):
             raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
+        gain = None if plan.gain is None else plan.gain[a:z]
+        prm = block_parameters(plan, b)
+        if k.device == "cuda":
+            from sarcli.gpu.csa_xp import focus_rows
+            from sarcli.gpu.device import require_cuda
+
+            t0 = time.perf_counter()
+            img = focus_rows(plan, b, data, a - (s - g.pad), gain, prm, require_cuda())
+            _add(tm, "cuda_block_s", t0)
+        else:
+            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain, prm)
+        del data
+        return self._correct_block(plan, b, img)  # type: ignore[arg-type]  # RD's attributes
+
+    def _focus_rows(self, plan: CsaPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
+                    gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
+        """Steps 1-4 of the module docstring on the CPU: the block's (N x n_samples) azimuth-compressed lines,
+        raw lines ``data`` (times ``gain`` per line) at row ``off``."""
+        k, g = plan.options, plan.grid
+        nr = plan.output_shape[1]
+        tm = plan.timings
         t0 = time.perf_counter()
         cdt = np.complex64 if k.precision == "single" else np.complex128
         y = np.zeros((plan.n_fft_az, plan.n_fft_r), cdt)
-        off = a - (s - g.pad)
-        y[off:off + z - a, :nr] = data
-        if plan.gain is not None:
-            y[off:off + z - a, :nr] *= plan.gain[a:z, None]
-        del data
+        y[off:off + data.shape[0], :nr] = data
+        if gain is not None:
+            y[off:off + data.shape[0], :nr] *= gain[:, None]
         _fft_inplace(y[:, :nr], 0, False, k.workers)
         _add(tm, "azimuth_fft_s", t0)
         t0 = time.perf_counter()
-        q = plan.block[b]
-        cols = np.arange(nr)
-        fdc_r, v_r = (float(np.interp(plan.c_ref, cols, q[n])) for n in ("fdc", "v"))
-        rp = row_parameters(plan.f_bin, g.prf, fdc_r, v_r, plan.r_ref, plan.d_ref, radar, k.src)
-        pos = column_positions(g.ranges, q["fdc"], q["v"], v_r, plan.d_ref, g.wavelength)
+        q, rp = plan.block[b], prm["rows"]
         factor = k.range_oversample
-        dr = float(g.ranges[1] - g.ranges[0])
-        pos = (pos - float(g.ranges[0])) / dr * factor
-        k_r = radar.chirp_rate_hz_per_s
-        k2 = rp["km"] * (1.0 + rp["a"])
-        inv_band = 1.0 / (chirp_band(radar) * k.range_bandwidth_fraction * (1.0 + rp["a"]))
-        # 1 / (T sqrt|K'|): a unit chirp compresses to ~1 (module docstring); x factor: the IFFT of the
-        # zero-padded spectrum divides by factor x L
-        gain = factor / (radar.pulse_length_s * np.sqrt(np.abs(k2)))
-        f_tau = sfft.fftfreq(plan.n_fft_r, 1.0 / radar.range_sampling_rate_hz)
-        tau0 = 2.0 * float(g.ranges[0]) / C
-        dtau = 1.0 / radar.range_sampling_rate_hz
-        # rows outside the processed band at every column are zero: skipped
-        offs = rp["f"][:, None] - q["fdc"][None, ::16]
-        active = np.any(np.abs(offs) <= 0.5 * g.ba * (1.0 + 1e-9), axis=1)
         out = y[:, :nr]
+        active = prm["active"]
         out[~active] = 0.0
         edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
         chunks = [(c, min(bb, c + CHUNK)) for aa, bb in zip(edges[::2], edges[1::2], strict=True)
@@ -565,23 +600,20 @@ class ChirpScaling(RangeDoppler):
         buffers: queue.SimpleQueue = queue.SimpleQueue()
         for _ in range(n_threads):
             buffers.put(np.empty((min(CHUNK, y.shape[0]), factor * plan.n_fft_r), cdt))
-        q2 = np.pi * rp["km"] * rp["a"]
-        c2 = np.pi / k2
-        c1 = 2.0 * np.pi * rp["delta_b"]
-        c0 = -0.25 * np.pi * np.sign(k_r)
 
         def run(c: int, d: int) -> None:
             buf = buffers.get()
             try:
                 rows = y[c:d]
-                chirp_scale(rows, nr, q2[c:d], rp["tau_r"][c:d], tau0, dtau)
+                chirp_scale(rows, nr, prm["q2"][c:d], rp["tau_r"][c:d], prm["tau0"], prm["dtau"])
                 _fft_inplace(rows, 1, False, 1)
                 up = buf[:d - c]
-                csa_range_filter(rows, f_tau, inv_band[c:d], c2[c:d], c1[c:d], c0, gain[c:d], plan.wtab_r, up)
+                csa_range_filter(rows, prm["f_tau"], prm["inv_band"][c:d], prm["c2"][c:d], prm["c1"][c:d],
+                                 prm["c0"], prm["gain"][c:d], plan.wtab_r, up)
                 _fft_inplace(up, 1, True, 1)
-                csa_azimuth(up, rp["f"][c:d], plan.f_bin[c:d], pos, g.ranges, q["v"], q["fdc"], q["dt"], q["ph0"],
-                            rp["km"][c:d], rp["a"][c:d], rp["tau_r"][c:d], g.wavelength, g.prf, g.ba, g.shift,
-                            plan.wtab_a, parse_interpolator(k.interpolator)[0], plan.table, out[c:d])
+                csa_azimuth(up, rp["f"][c:d], plan.f_bin[c:d], prm["pos"], g.ranges, q["v"], q["fdc"], q["dt"],
+                            q["ph0"], rp["km"][c:d], rp["a"][c:d], rp["tau_r"][c:d], g.wavelength, g.prf, g.ba,
+                            g.shift, plan.wtab_a, parse_interpolator(k.interpolator)[0], plan.table, out[c:d])
             finally:
                 buffers.put(buf)
 
@@ -591,7 +623,7 @@ class ChirpScaling(RangeDoppler):
         t0 = time.perf_counter()
         _fft_inplace(img, 0, True, k.workers)
         _add(tm, "azimuth_ifft_s", t0)
-        return self._correct_block(plan, b, img)  # type: ignore[arg-type]  # RD's attributes
+        return img
 
     def finish(self, plan: CsaPlan) -> SLC:  # type: ignore[override]
         g, raw, k = plan.grid, plan.raw, plan.options

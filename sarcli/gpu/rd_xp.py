@@ -56,13 +56,40 @@ def range_filter_rows(xp: Any, y: Any, h: Any, f_tau: Any, inv_k: Any, n_out: in
     return out
 
 
-def _lookup(xp: Any, tab: Any, u: Any) -> Any:
+def lookup(xp: Any, tab: Any, u: Any) -> Any:
     """Linear lookup of a window table on u in [-1/2, 1/2] (:func:`sarcli.focus.windows.table_lookup`)."""
     n = tab.shape[0]
     t = (u + 0.5) * (n - 1)
     j = xp.minimum(xp.floor(t).astype(xp.int64), n - 2)
     a = t - j
     return tab[j] * (1.0 - a) + tab[j + 1] * a
+
+
+def sample_rows(xp: Any, s: Any, p: Any, kind: int, table: Any) -> Any:
+    """Rows ``s`` (rows x n) read at positions ``p`` (rows x m, samples), zeros outside: nearest (kind 0),
+    linear (1) or the windowed-sinc ``table`` at the nearest of its phases (2), as the numba kernels
+    (:func:`sarcli.focus.rcmc.rcmc_azimuth`) read them."""
+    taps = 1 if kind == 0 else (2 if kind == 1 else table.shape[1])
+    pad = taps + 1
+    rows, nrow = s.shape
+    padded = xp.zeros((rows, nrow + 2 * pad), s.dtype)
+    padded[:, pad:pad + nrow] = s
+
+    def take(idx: Any) -> Any:
+        return xp.take_along_axis(padded, xp.clip(idx + pad, 0, nrow + 2 * pad - 1), axis=1)
+
+    if kind == 0:
+        return take(xp.floor(p + 0.5).astype(xp.int64))
+    j = xp.floor(p).astype(xp.int64)
+    if kind == 1:
+        mu = (p - j).astype(table.dtype)
+        return take(j) * (1.0 - mu) + take(j + 1) * mu
+    jp = ((p - j) * (table.shape[0] - 1) + 0.5).astype(xp.int64)
+    b = j - (taps // 2 - 1)
+    val = xp.zeros(p.shape, s.dtype)
+    for t in range(taps):
+        val += take(b + t) * table[jp, t]
+    return val
 
 
 def rcmc_azimuth_rows(xp: Any, s: Any, f_bin: Any, r_first: float, dr: float, r0: Any, v: Any, fdc: Any, dt: Any,
@@ -82,30 +109,8 @@ def rcmc_azimuth_rows(xp: Any, s: Any, f_bin: Any, r_first: float, dr: float, r0
           - 2.0 * math.pi * f * dt[None, :] + ph0[None, :])
     u = off / ba
     inside = xp.abs(u) <= 0.5
-    w = xp.where(inside, _lookup(xp, wtab, xp.clip(u, -0.5, 0.5)), 0.0)
-    taps = 1 if kind == 0 else (2 if kind == 1 else table.shape[1])
-    pad = taps + 1
-    rows, nrow = s.shape
-    padded = xp.zeros((rows, nrow + 2 * pad), s.dtype)
-    padded[:, pad:pad + nrow] = s
-
-    def take(idx: Any) -> Any:
-        return xp.take_along_axis(padded, xp.clip(idx + pad, 0, nrow + 2 * pad - 1), axis=1)
-
-    if kind == 0:
-        val = take(xp.floor(p + 0.5).astype(xp.int64))
-    elif kind == 1:
-        j = xp.floor(p).astype(xp.int64)
-        mu = (p - j).astype(table.dtype)
-        val = take(j) * (1.0 - mu) + take(j + 1) * mu
-    else:
-        nph = table.shape[0] - 1
-        j = xp.floor(p).astype(xp.int64)
-        jp = ((p - j) * nph + 0.5).astype(xp.int64)
-        b = j - (taps // 2 - 1)
-        val = xp.zeros(p.shape, s.dtype)
-        for t in range(taps):
-            val += take(b + t) * table[jp, t]
+    w = xp.where(inside, lookup(xp, wtab, xp.clip(u, -0.5, 0.5)), 0.0)
+    val = sample_rows(xp, s, p, kind, table)
     return (val * (w * xp.exp(1j * ph))).astype(s.dtype)
 
 
