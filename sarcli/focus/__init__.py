@@ -22,5 +22,6 @@ from sarcli.registry import Registry
 FOCUSERS: Registry = Registry("focuser", "sarcli.focusers", {
     "rd": "sarcli.focus.rda:RD",
     "backprojection": "sarcli.focus.bp_product:BACKPROJECTION",
+    "omegak": "sarcli.focus.omegak:OMEGAK",
     "optical": "sarcli.optical.focus_plugin:OPTICAL",
 }, check=check_focuser)
