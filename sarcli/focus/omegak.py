@@ -52,10 +52,14 @@ Range-varying effective velocity (orbit). Steps 1-2 use V_ref; a target at R0 wi
 the mapping, the phase -(4 pi R0 / c) sqrt((f0 + f_tau')^2 + a_ref^2 - a_V^2). At the band centre
 f_tau' = c_k this is -(4 pi R0 / lam) D(f, V(R0)) instead of -(4 pi R0 / lam) D(f, V_ref): the column
 correction exp(+j (4 pi R0 / lam)(D(f, V(R0)) - D(f, V_ref))) removes it exactly at the carrier
-[CumWong2005, sec. 8.5, the differential azimuth compression]. What remains is its f_tau'-dependence: a
-range shift R0 (D_ref / D_V - 1) ~ R0 sin^2(theta) dV / V (0.1 mm for Radarsat-1's 6 m/s across the
-swath at -6 PRF; zero with a linear track) and a range-quadratic phase of the same relative size
-(below 1e-3 rad). The centroid varying across the swath is exact (window per column) as long as each
+[CumWong2005, sec. 8.5, the differential azimuth compression]. Its slope in f_tau' moves the target's
+range envelope by R0 (D_ref / D_V - 1) ~ R0 sin^2(theta) dV / V (0.3 m, 0.05 sample, at the edge of a
+Radarsat-1 swath at -6 PRF with 3 m/s of V from its centre; zero with a linear track): the column
+correction takes the envelope there (band-pass 8-tap sinc around the row's carrier, where the shift
+exceeds 1e-3 sample: the differential RCMC). What remains is the curvature in f_tau' (a range-quadratic
+phase (4 pi R0 / c) (a_V^2 - a_ref^2) f_tau'^2 / (2 f0^3 D^3), below 1e-4 rad there) and the
+interpolation error of a shift of hundredths of a sample (< 1e-3, tests).
+The centroid varying across the swath is exact (window per column) as long as each
 column's processed band lies within half a PRF of fdc_ref (the absolute frequency of a 2-D bin is the
 same for every column): |fdc(R) - fdc_ref| + Ba / 2 <= PRF / 2, checked in the plan (one-line error).
 
@@ -116,6 +120,8 @@ from sarcli.model.slc import SLC
 from sarcli.model.terrain import Terrain
 
 STOLT_MODES = ("full", "monochromatic")
+SHIFT_TOL_SAMPLES = 1e-3  # differential range shifts below this (samples) are not interpolated
+DIFF_INTERPOLATOR = "sinc8"  # the differential range shift's kernel (shifts are hundredths of a sample)
 
 
 @dataclass(frozen=True)
@@ -292,13 +298,21 @@ def stolt_rows_numpy(x: np.ndarray, h: np.ndarray, f_tau: np.ndarray, f_eta: np.
 
 
 @njit(nogil=True, cache=True)
-def column_corrections(z, f_bin, r0, v, v_ref, fdc, dt, ph0, wavelength, prf, ba, wtab, shift, out):
-    """Step 4 of the module docstring on rows of the range-Doppler domain: out[k, i] = z[k, i] x
-    W((f - fdc_i) / Ba) x exp(j [(4 pi r0_i / lam)(D(f, v_i) - D(f, v_ref)) + pi/4 - 2 pi f_bin shift / PRF
-    - 2 pi f dt_i + ph0_i]), f = fdc_i + wrap(f_bin - fdc_i) (zero outside the band). D(f, v_i) - D(f, v_ref)
-    = (x_ref - x_i) / (D_i + D_ref), x = (lam f / 2v)^2: no cancellation. Serial and GIL-free."""
-    rows = z.shape[0]
+def column_corrections(z, f_bin, r0, v, v_ref, fdc, dt, ph0, wavelength, prf, ba, wtab, shift, f0, dr, table, out):
+    """Step 4 of the module docstring on rows of the range-Doppler domain (``z`` may be longer than the
+    ``len(r0)`` output columns): out[k, i] = s_i x W((f - fdc_i) / Ba) x exp(j [(4 pi r0_i / lam)(D(f, v_i) -
+    D(f, v_ref)) + pi/4 - 2 pi f_bin shift / PRF - 2 pi f dt_i + ph0_i]), f = fdc_i + wrap(f_bin - fdc_i)
+    (zero outside the band). D(f, v_i) - D(f, v_ref) = (x_ref - x_i) / (D_i + D_ref), x = (lam f / 2v)^2:
+    no cancellation. s_i: z[k, i], or where the differential range shift delta = r0_i (D_ref / D_i - 1) / dr
+    reaches ``SHIFT_TOL_SAMPLES``, the row's ENVELOPE at i + delta: band-pass interpolation around the
+    row's range carrier c = f0 (D_ref - 1) (cycles per sample c / fs = c dr 2 / c_light), remodulated at
+    i (the carrier phase belongs to the differential azimuth term), with the windowed-sinc ``table``.
+    Serial and GIL-free."""
+    rows, n = z.shape
     nr = r0.shape[0]
+    nph = table.shape[0] - 1
+    taps = table.shape[1]
+    k0 = taps // 2 - 1
     for k in range(rows):
         fb = f_bin[k]
         psh = -2.0 * np.pi * fb * shift / prf + 0.25 * np.pi
@@ -312,9 +326,30 @@ def column_corrections(z, f_bin, r0, v, v_ref, fdc, dt, ph0, wavelength, prf, ba
             f = fdc[i] + off
             xi = (wavelength * f / (2.0 * v[i])) ** 2
             xr = (wavelength * f / (2.0 * v_ref)) ** 2
-            dd = (xr - xi) / (math.sqrt(1.0 - xi) + math.sqrt(1.0 - xr))
+            di = math.sqrt(1.0 - xi)
+            dref = math.sqrt(1.0 - xr)
+            dd = (xr - xi) / (di + dref)
             ph = 4.0 * np.pi * r0[i] * dd / wavelength + psh - 2.0 * np.pi * f * dt[i] + ph0[i]
-            out[k, i] = z[k, i] * (table_lookup(wtab, u) * complex(math.cos(ph), math.sin(ph)))
+            delta = -r0[i] * dd / (di * dr)
+            if abs(delta) < SHIFT_TOL_SAMPLES:
+                val = complex(z[k, i])
+            else:
+                # carrier in cycles per sample: f0 (D_ref - 1) / fs, fs = c_light / (2 dr)
+                cyc = -f0 * xr / (1.0 + dref) * 2.0 * dr / 2.99792458e8
+                p = i + delta
+                n0 = int(math.floor(p))
+                jp = int((p - n0) * nph + 0.5)
+                a = 2.0 * np.pi * ((cyc * (i - n0 + k0)) % 1.0)
+                rot = complex(math.cos(a), math.sin(a))
+                b = -2.0 * np.pi * (cyc % 1.0)
+                step = complex(math.cos(b), math.sin(b))
+                val = 0j
+                for t in range(taps):
+                    m = n0 - k0 + t
+                    if 0 <= m < n:
+                        val += z[k, m] * (table[jp, t] * rot)
+                    rot *= step
+            out[k, i] = val * (table_lookup(wtab, u) * complex(math.cos(ph), math.sin(ph)))
 
 
 @njit(nogil=True, cache=True)
@@ -465,6 +500,7 @@ class Omegak(RangeDoppler):
         for _ in range(min(_n_threads(k.workers), max(1, len(chunks)))):
             buffers.put(np.empty((min(CHUNK, y.shape[0]), plan.n_fft_r), y.dtype))
         table = plan.stolt_table.astype(np.float32 if k.precision == "single" else np.float64)
+        diff_table = table_for(DIFF_INTERPOLATOR)[1]
 
         def run(c: int, d: int) -> None:
             buf = buffers.get()
@@ -473,8 +509,9 @@ class Omegak(RangeDoppler):
                 stolt_rows(y[c:d], plan.h, f_tau, f_eta[c:d], float(plan.v_ref[b]), float(plan.r_ref[b]), tau0,
                            f0, fs, plan.stolt_kind, table, row)
                 _fft_inplace(row, 1, True, 1)
-                column_corrections(row[:, :nr], plan.f_bin[c:d], g.ranges, q["v"], float(plan.v_ref[b]), q["fdc"],
-                                   q["dt"], q["ph0"], g.wavelength, g.prf, g.ba, plan.wtab, g.shift, out[c:d])
+                column_corrections(row, plan.f_bin[c:d], g.ranges, q["v"], float(plan.v_ref[b]), q["fdc"], q["dt"],
+                                   q["ph0"], g.wavelength, g.prf, g.ba, plan.wtab, g.shift, f0, C / (2.0 * fs),
+                                   diff_table, out[c:d])
             finally:
                 buffers.put(buf)
 

@@ -9,9 +9,10 @@ Scenes (tests/focus/synth.py, flat hyperbolic geometry, constant V):
 - airborne X band, squint 0 / 20 / 40 deg: V 150 m/s, lam 3.1 cm, R0 ~ 1.4 km, PRF 500 Hz, chirp 100 MHz
   x 1 us at 150 MHz (relative bandwidth 1 %, 80 % of it processed), exposure 420 Hz, 300 Hz processed
   (60 Hz inside each edge: 1.9 sqrt(|fr|) at broadside, and twice the 29 Hz the band edges move by
-  across the range band at 40 deg). The targets sit on integer output pixels (line and column), so the image sample there IS the peak: its phase is compared
-  with -4 pi R0 / lam without any interpolation (at 40 deg the range carrier is 15 cycles per sample
-  modulo 1, and a fractional-peak phase would need it absolutely).
+  across the range band at 40 deg). The targets sit on integer output pixels (line and column), so the
+  image sample there IS the peak: its phase is compared with -4 pi R0 / lam without any interpolation
+  (at 40 deg the range carrier is 15 cycles per sample modulo 1, and a fractional-peak phase would
+  need it absolutely).
 
 At squint the closest-range wavenumber support of every azimuth-frequency row is centred on
 c(f) = f0 (D(f) - 1) (module docstring of sarcli.focus.omegak): the image carries that range carrier,
@@ -379,8 +380,9 @@ def test_centroid_and_velocity_varying_across_the_swath():
     """An orbit-like swath: V from 7060 to 7066 m/s and the centroid from -6 PRF - 90 Hz to -6 PRF + 90 Hz
     across 768 samples (each target's echo from its own V and squint; the Doppler model is that
     geometry indexed by beam-centre range). The differential velocity correction makes the phase
-    exact at the carrier; what remains (module docstring) is below 1e-3 rad here. Bar: 0.02 rad, 0.01
-    pixel, IRW 0.5 %."""
+    exact at the carrier, the differential RCMC the range position (without it: 0.043 sample at the
+    near target); what remains (module docstring) is below 1e-3 rad. Bar: 0.01 rad (measured 3e-3, RD
+    the same), 0.01 pixel, IRW 0.5 %."""
     lam, prf, ba, v0, dv, f_mid, df = 0.0566, 1500.0, 1000.0, 7063.0, 6.0, -6.0 * 1500.0, 180.0
     r_first, n = 850e3, 768
     r_mid = r_first + n / 2 * DR
@@ -401,14 +403,14 @@ def test_centroid_and_velocity_varying_across_the_swath():
             return -2 * v_of(r) ** 2 * (1 - s_of(r) ** 2) / (lam * r)
 
     echo, targets = None, []
-    for k, x in enumerate((150.3, 384.6, 620.2)):
+    for k, x in enumerate((150, 270, 390)):  # integer pixels; echoes (R_c = R0 + 100 samples, +-254) recorded
         r0 = r_first + x * DR
         rc = r0
         for _ in range(50):
             rc = r0 / np.sqrt(1 - s_of(rc) ** 2)
         v, s = v_of(rc), s_of(rc)
-        eta0 = 0.45 + 0.1 * k - r0 * s / np.sqrt(1 - s * s) / v
-        raw = scene([(r0, eta0, 1.0)], n_lines=1200, n_samples=n, prf=prf, velocity=v, fdc=-2 * v * s / lam,
+        eta0 = np.round((0.35 + 0.1 * k - r0 * s / np.sqrt(1 - s * s) / v) * prf) / prf
+        raw = scene([(r0, eta0, 1.0)], n_lines=1400, n_samples=n, prf=prf, velocity=v, fdc=-2 * v * s / lam,
                     exposure_bw_hz=1300.0, dtype=np.complex128)
         echo = raw.echo if echo is None else echo + raw.echo
         targets.append((r0, eta0, -2 * v * s / lam))
@@ -423,7 +425,9 @@ def test_centroid_and_velocity_varying_across_the_swath():
         col = (r0 - r_first) / DR
         m = point_target_metrics(slc.image, row, col, azimuth_carrier=fdc / prf)
         assert abs(m["row"] - row) < 0.01 and abs(m["col"] - col) < 0.01, (m["row"] - row, m["col"] - col)
-        assert abs(np.angle(np.exp(1j * (m["peak_phase_rad"] + 4 * np.pi * r0 / lam)))) < 0.02
+        # the sample on the target (a phase at a measured fractional peak would carry 2 pi 6 x its
+        # position error of a few 1e-3 line: the carrier is -6 cycles per line)
+        assert abs(np.angle(slc.image[int(round(row)), int(round(col))] * np.exp(4j * np.pi * r0 / lam))) < 0.01
         assert m["irw_azimuth_px"] == pytest.approx(th["irw"] * prf / ba, rel=0.005)
         assert m["irw_range_px"] == pytest.approx(th["irw"] * FS / B_RANGE, rel=0.005)
 
@@ -447,17 +451,19 @@ def test_centroid_spread_beyond_half_a_prf_is_refused():
 @pytest.mark.slow
 def test_l_band_aperture_of_three_seconds():
     """ALOS/NISAR-like: lam 23.6 cm, V 7000 m/s, R0 700 km: |fr| 593 Hz/s, a 1780 Hz band processed is a
-    3.0 s aperture (6000 lines at 2000 Hz), chirp 28 MHz at 32 MHz, squint 3 deg. IRW 0.5 %, PSLR 0.3 dB,
-    position 0.01 pixel, phase 0.02 rad."""
+    3.0 s aperture (6000 lines at 2000 Hz), chirp 28 MHz x 10 us at 32 MHz, squint 0.5 deg (the
+    migration over the band, R0 (1/D - 1) up to 200 m = 42 samples, stays in the 384-sample window).
+    The issue's quality: IRW 2 %, PSLR 1 dB (measured: range IRW -0.7 %, the TBP-280 chirp's ripple 1.7
+    sqrt(K) inside the processed band edge), position 0.01 pixel, phase at the target's sample 0.02 rad."""
     lam, prf, fs, v, r_first = 0.236, 2000.0, 32e6, 7000.0, 700e3
     dr = C / (2 * fs)
     fr = 2 * v**2 / (lam * r_first)
     ba = 3.0 * fr
-    s = np.sin(np.radians(3.0))
+    s = np.sin(np.radians(0.5))
     fdc = -2 * v * s / lam
-    r0 = r_first + 192.4 * dr
-    eta0 = 1.7 - r0 * s / np.sqrt(1 - s * s) / v
-    raw = scene([(r0, eta0, 1.0)], n_lines=7000, n_samples=384, prf=prf, fs=fs, chirp_rate=-28e6 / 5e-6, pulse=5e-6,
+    r0 = r_first + 150 * dr
+    eta0 = np.round((1.7 - r0 * s / np.sqrt(1 - s * s) / v) * prf) / prf  # on an output line
+    raw = scene([(r0, eta0, 1.0)], n_lines=7000, n_samples=384, prf=prf, fs=fs, chirp_rate=-28e6 / 10e-6, pulse=10e-6,
                 wavelength=lam, velocity=v, fdc=fdc, r_first=r_first, exposure_bw_hz=ba + 150.0)
     dop = GeometricDoppler(v, s, lam)
     slc = focus_omegak(raw, dop, range_window="rect", azimuth_window="rect", range_bandwidth_fraction=0.9,
@@ -467,12 +473,12 @@ def test_l_band_aperture_of_three_seconds():
     col = (r0 - r_first) / dr
     m = point_target_metrics(slc.image, row, col, azimuth_carrier=fdc / prf)
     th = irf_theory("rect")
-    assert m["irw_range_px"] == pytest.approx(th["irw"] * fs / (0.9 * 28e6), rel=0.005)
-    assert m["irw_azimuth_px"] == pytest.approx(th["irw"] * prf / ba, rel=0.005)
+    assert m["irw_range_px"] == pytest.approx(th["irw"] * fs / (0.9 * 28e6), rel=0.02)
+    assert m["irw_azimuth_px"] == pytest.approx(th["irw"] * prf / ba, rel=0.02)
     for ax in ("range", "azimuth"):
-        assert abs(m[f"pslr_{ax}_db"] - th["pslr_db"]) < 0.3, (ax, m)
+        assert abs(m[f"pslr_{ax}_db"] - th["pslr_db"]) < 1.0, (ax, m)
     assert abs(m["row"] - row) < 0.01 and abs(m["col"] - col) < 0.01
-    assert abs(np.angle(np.exp(1j * (m["peak_phase_rad"] + 4 * np.pi * r0 / lam)))) < 0.02
+    assert abs(np.angle(slc.image[int(round(row)), int(round(col))] * np.exp(4j * np.pi * r0 / lam))) < 0.02
 
 
 def test_single_precision_round_off_is_bounded(space):
