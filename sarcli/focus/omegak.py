@@ -22,7 +22,7 @@ Full Stolt (``stolt = "full"``). Per block (V_ref, fdc_ref at the mid-swath colu
 1. reference function multiply (RFM, bulk focusing) at R_ref, with the matched filter H_r:
    exp(+j (4 pi R_ref / c) sqrt((f0 + f_tau)^2 - a^2) - j 2 pi f_tau tau0): a target at R_ref is now
    focused; one at R0 keeps -(4 pi (R0 - R_ref) / c) sqrt((f0 + f_tau)^2 - a^2);
-2. Stolt mapping f0 + f_tau' = sqrt((f0 + f_tau)^2 - a^2) [Stolt 1978, via Cafforio1991]: the row is
+2. Stolt mapping f0 + f_tau' = sqrt((f0 + f_tau)^2 - a^2) [Stolt1978] (via [Cafforio1991]): the row is
    resampled on a uniform f_tau' grid, the input taken at f_tau = sqrt((f0 + f_tau')^2 + a^2) - f0 by a
    windowed-sinc (or linear) kernel (knob ``stolt_kernel``); the residual becomes LINEAR in f_tau',
    -(4 pi (R0 - R_ref) / c)(f0 + f_tau'): every range is focused at once, exactly for constant V; the

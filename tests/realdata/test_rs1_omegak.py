@@ -1,7 +1,7 @@
 """The real Radarsat-1 Vancouver blocks through ``rd`` and ``omegak`` (full Stolt and monochromatic) with the
 same Doppler input (estimated once by sarcli.doppler): the images must be the same scene equally well
 focused. Contrast std(I)/mean(I) and entropy -sum p ln p (p = I / sum I) over the lines fully focused
-agree within 2 % ("a few per cent", issue 26; measured: 0.03 % and 1e-5 relative on the coal/ferry
+agree within 2 % ("a few per cent"; measured: 0.03 % and 1e-5 relative on the coal/ferry
 block), and the images register within 0.1 pixel (sub-pixel cross-correlation of the amplitudes,
 plain numpy; measured 0.00 pixel). The centroid varies by 80 Hz across the swath here, within the
 (PRF - Ba)/2 = 125 Hz a 2-D spectrum can unwrap."""
