@@ -96,7 +96,7 @@ from numba import njit
 from sarcli.errors import ConfigError, SarcliError
 from sarcli.focus.interp import interpolate_numpy, parse_interpolator, table_for
 from sarcli.focus.kinematics import migration_factor
-from sarcli.focus.rangecomp import C, range_filter, reference_pulse
+from sarcli.focus.rangecomp import C, chirp_band, range_filter, reference_pulse
 from sarcli.focus.rda import (
     CHUNK,
     RANGE_GUARD,
@@ -557,6 +557,15 @@ class Omegak(RangeDoppler):
         slc.parameters.update(reference_range_m=[float(r) for r in plan.r_ref],
                               reference_velocity_mps=[float(v) for v in plan.v_ref],
                               unwrap_centroid_hz=[float(f) for f in plan.fdc_ref])
+        if plan.options.stolt == "monochromatic":
+            # eq. (2) at the swath edges, the processed band's corners: the largest phase error predicted
+            g, radar = plan.grid, plan.raw.radar
+            half_b = 0.5 * plan.options.range_bandwidth_fraction * chirp_band(radar)
+            err = [abs(float(monochromatic_phase_error(float(g.ranges[i]), float(r), fc + sa * 0.5 * g.ba,
+                                                       sb * half_b, float(v), radar.carrier_frequency_hz)))
+                   for r, v, fc in zip(plan.r_ref, plan.v_ref, plan.fdc_ref, strict=True)
+                   for i in (0, -1) for sa in (-1.0, 1.0) for sb in (-1.0, 1.0)]
+            slc.parameters["monochromatic_phase_error_max_rad"] = max(err)
         return slc
 
 

@@ -338,6 +338,14 @@ def test_airborne_full_band_agrees_with_backprojection(air, sq):
         assert abs(np.angle(bp[24, 24] * np.exp(4j * np.pi * r0 / A_LAM))) < 0.01
 
 
+def _bracket(fe, ft):
+    """sqrt((f0 + f_tau)^2 - a^2) - f0 D - f_tau / D of eq. 2 (plain numpy, float64)."""
+    f0 = C / A_LAM
+    a2 = (C * fe / (2 * A_V)) ** 2
+    d = np.sqrt(1 - a2 / f0**2)
+    return (np.sqrt((f0 + ft) ** 2 - a2) - f0 * d) - ft / d
+
+
 def predicted_monochromatic_error(r0, r_ref, fdc, ba, band, n=201):
     """The monochromatic residual (module docstring eq. 2, exact bracket) averaged over the processed
     (rect x rect) support: the complex peak ratio to a perfect focus, plain numpy."""
@@ -370,6 +378,13 @@ def test_monochromatic_error_matches_its_prediction(air, sq):
         assert abs(np.angle(rd / pred)) < 2e-3 + 0.1 * abs(np.angle(pred))
     if sq == 40.0:  # the error is real: 0.05 rad at 112 samples from the reference
         assert abs(np.angle(pred)) > 0.04
+    # the SLC reports eq. 2's largest value (swath edge, band corner), which bounds the mean's phase
+    edge = case["mono"].parameters["monochromatic_phase_error_max_rad"]
+    r_far = A_RF + (A_NR - 1) * A_DR
+    corner = max(abs(4 * np.pi * (r - r_ref) / C * _bracket(fdc + sa * 0.5 * A_BA, sb * 0.5 * A_FRACTION * A_B))
+                 for r in (A_RF, r_far) for sa in (-1, 1) for sb in (-1, 1))
+    assert edge == pytest.approx(corner, rel=1e-6)
+    assert edge >= abs(np.angle(pred))
 
 
 # ---------------------------------------------------------------- hard cases
