@@ -232,6 +232,8 @@ def stolt_rows(x, h, f_tau, f_eta, v_ref, r_ref, tau0, f0, fs, kind, table, out)
     k0 = taps // 2 - 1
     kr = 4.0 * np.pi * r_ref / 2.99792458e8
     u = np.empty(n, np.complex128)
+    u_re = np.empty(n)
+    u_im = np.empty(n)
     for k in range(rows):
         a2 = (2.99792458e8 * f_eta[k] / (2.0 * v_ref)) ** 2
         d = math.sqrt(1.0 - a2 / (f0 * f0))
@@ -260,7 +262,10 @@ def stolt_rows(x, h, f_tau, f_eta, v_ref, r_ref, tau0, f0, fs, kind, table, out)
             for jj in range(j, e):
                 m = jj - half
                 q = m if m >= 0 else m + n
-                u[jj] = x[k, q] * h[q] * cur
+                uv = x[k, q] * h[q] * cur
+                u[jj] = uv
+                u_re[jj] = uv.real
+                u_im[jj] = uv.imag
                 cur *= step
                 step *= curv
             j = e
@@ -293,13 +298,22 @@ def stolt_rows(x, h, f_tau, f_eta, v_ref, r_ref, tau0, f0, fs, kind, table, out)
             else:
                 jp = int((p - i) * nph + 0.5)
                 b = i - k0
+                # real weights on the real and imaginary parts (a complex-by-real product in numba is a
+                # full complex multiply)
+                acc_re = 0.0
+                acc_im = 0.0
                 if b >= 0 and b + taps <= n:
                     for t in range(taps):
-                        val += u[b + t] * table[jp, t]
+                        wt = table[jp, t]
+                        acc_re += u_re[b + t] * wt
+                        acc_im += u_im[b + t] * wt
                 else:
                     for t in range(taps):
                         if 0 <= b + t < n:
-                            val += u[b + t] * table[jp, t]
+                            wt = table[jp, t]
+                            acc_re += u_re[b + t] * wt
+                            acc_im += u_im[b + t] * wt
+                val = complex(acc_re, acc_im)
             # Jacobian of the change of variable, d f_tau / d f_tau' = (f0 + f_tau') / (f0 + f_tau)
             out[k, q] = val * ((f0 + ck + w) / (f0 + fin)) * cur
 
