@@ -24,5 +24,6 @@ FOCUSERS: Registry = Registry("focuser", "sarcli.focusers", {
     "rd": "sarcli.focus.rda:RD",
     "csa": "sarcli.focus.csa:CSA",
     "backprojection": "sarcli.focus.bp_product:BACKPROJECTION",
+    "omegak": "sarcli.focus.omegak:OMEGAK",
     "optical": "sarcli.optical.focus_plugin:OPTICAL",
 }, check=check_focuser)

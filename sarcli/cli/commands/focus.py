@@ -101,6 +101,8 @@ def focus(
 
       sarcli focus raw.h5 -o bp.h5 --algorithm backprojection --set lines=[900,1000] --range-window rect
 
+      sarcli focus raw.h5 -o wk.h5 --algorithm omegak --set stolt_kernel=sinc8
+
       sarcli focus big_raw.h5 -o slc.h5 --fdc -6690 --fr -1990 --workers 2
 
       sarcli focus raw.h5 -o slc.h5 --device cuda    # on the GPU (pip install 'sarcli[gpu]')
