@@ -329,6 +329,9 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
             echo = load_echo().channel(ch) if focuser.streams else plan_raw.echo
             slc = run_blocks(focuser, plan, lambda a, b: echo[a:b], sink, on_block)
         slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": config.stored()}
+        from sarcli.calibration.radiometry import annotate
+
+        slc.calibration = annotate(slc, load_echo.raw or raw, shape[1])
         meta.update_from(slc)
     return slc, sink
 
