@@ -261,9 +261,13 @@ def noise_power(raw) -> tuple[float | None, str]:
     level it states (``radar.noise_power``), else (None, why)."""
     for name, lines in sorted((getattr(raw, "auxiliary", None) or {}).items()):
         if name.rsplit("/", 1)[-1] == "noise" and np.size(lines):
-            x = np.asarray(lines)
-            p = float(np.mean(x.real.astype(np.float64) ** 2 + x.imag.astype(np.float64) ** 2))
-            return p, f"measured on {x.shape[0] if x.ndim > 1 else 1} noise line(s) ({name})"
+            x = np.atleast_2d(np.asarray(lines))
+            x = x.reshape(-1, x.shape[-1])
+            p = x.real.astype(np.float64) ** 2 + x.imag.astype(np.float64) ** 2
+            # a reader pads lines to the widest with zeros: each line up to its last non-zero sample
+            keep = np.flip(np.cumsum(np.flip(p > 0, axis=1), axis=1), axis=1) > 0
+            if keep.any():
+                return float(np.mean(p[keep])), f"measured on {x.shape[0]} noise line(s) ({name})"
     if raw.radar.noise_power is not None:
         return float(raw.radar.noise_power), "the receiver noise level stated by the product"
     return None, "no noise lines and no stated receiver noise level"
@@ -416,6 +420,7 @@ def calibrated_intensity(slc: SLC, inten: np.ndarray, looks_az: int, looks_rg: i
         if not np.any(np.isfinite(cal.nes0)):
             raise SarcliError("noise subtraction needs a noise floor: the product has no noise measurement")
         out -= lut_on(cal, "nes0", t, r) * lut / lut_on(cal, "sigma0", t, r)
+        out = np.where(out < 0.0, 0.0, out)  # below the noise floor: zero backscatter (-inf dB), as ESA's
     return out.astype(np.float32)
 
 
@@ -459,6 +464,22 @@ def trihedral_rcs(side_m: float, wavelength_m: float, u: np.ndarray | None = Non
     if u is None:
         u = np.full(3, 1.0 / math.sqrt(3.0))
     return 4.0 * math.pi * _trihedral_area(side_m, np.asarray(u, np.float64)) ** 2 / wavelength_m**2
+
+
+def reflector_rcs(cr, p_ecef: np.ndarray, radar_ecef: np.ndarray, wavelength_m: float) -> float:
+    """Theoretical RCS (m^2) of the corner reflector ``cr`` (:class:`sarcli.calibration.reflectors.CornerReflector`)
+    at ``p_ecef`` seen from the radar at ``radar_ecef``. The CSV's angles follow ISCE3's reading of the NISAR
+    corner-reflector specification [NISAR-CR-SIS]: ``azimuth_deg`` is the boresight's heading measured
+    clockwise from geographic EAST (so the boresight points to azimuth_deg + 90 clockwise from north),
+    ``tilt_deg`` tilts the reflector's vertical axis from the ellipsoid normal, raising the boresight
+    from its 35.26 deg above the base plate to 35.26 + tilt above the horizon."""
+    from sarcli.calibration.reflectors import enu_basis
+
+    u = np.asarray(radar_ecef, np.float64) - np.asarray(p_ecef, np.float64)
+    u_enu = enu_basis(cr.latitude_deg, cr.longitude_deg).T @ (u / np.linalg.norm(u))
+    el0 = math.degrees(math.asin(1.0 / math.sqrt(3.0)))
+    frame = plate_frame(cr.azimuth_deg + 90.0, el0 + cr.tilt_deg)
+    return trihedral_rcs(cr.side_length_m, wavelength_m, frame.T @ u_enu)
 
 
 def plate_frame(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
