@@ -256,18 +256,21 @@ def node_geometry(slc: SLC, t: np.ndarray, r: np.ndarray, height_m: float) -> Ge
 
 
 def noise_power(raw) -> tuple[float | None, str]:
-    """(P_n per raw complex sample, where it came from) of a raw product: the mean power of its noise lines
+    """(P_n per raw complex sample, where it came from) of a raw product: the variance of its noise lines
     (an ``auxiliary`` array named ``*noise``, e.g. Sentinel-1's ``s1/noise``), else the receiver noise
     level it states (``radar.noise_power``), else (None, why)."""
     for name, lines in sorted((getattr(raw, "auxiliary", None) or {}).items()):
         if name.rsplit("/", 1)[-1] == "noise" and np.size(lines):
             x = np.atleast_2d(np.asarray(lines))
             x = x.reshape(-1, x.shape[-1])
-            p = x.real.astype(np.float64) ** 2 + x.imag.astype(np.float64) ** 2
+            x = x.astype(np.complex128)
             # a reader pads lines to the widest with zeros: each line up to its last non-zero sample
-            keep = np.flip(np.cumsum(np.flip(p > 0, axis=1), axis=1), axis=1) > 0
+            keep = np.flip(np.cumsum(np.flip(x != 0, axis=1), axis=1), axis=1) > 0
             if keep.any():
-                return float(np.mean(p[keep])), f"measured on {x.shape[0]} noise line(s) ({name})"
+                v = x[keep]
+                # the variance: a receiver's DC offset (Sentinel-1's noise packet: 0.2 of a code on I) is a
+                # bias that the range filter's band rejects, not thermal noise
+                return float(np.mean(np.abs(v - v.mean()) ** 2)), f"measured on {x.shape[0]} noise line(s) ({name})"
     if raw.radar.noise_power is not None:
         return float(raw.radar.noise_power), "the receiver noise level stated by the product"
     return None, "no noise lines and no stated receiver noise level"

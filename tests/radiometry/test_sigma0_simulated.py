@@ -191,8 +191,10 @@ def _reflector_csv(slc, path: Path, rcs_m2: float) -> None:
     from sarcli.calibration.predict import image_orbit
     from sarcli.calibration.reflectors import enu_basis
 
+    from orbit.geodetic import geodetic_to_ecef
+
     tg = slc.truth["targets"][0]
-    p = np.array([tg["x_m"], tg["y_m"], tg["z_m"]])
+    p = np.asarray(geodetic_to_ecef(tg["lat_deg"], tg["lon_deg"], tg["height_m"]), np.float64)
     sat = image_orbit(slc).interpolate(np.array([tg["zero_doppler_time_s"]]))[0][0]
     u = enu_basis(tg["lat_deg"], tg["lon_deg"]).T @ ((sat - p) / np.linalg.norm(sat - p))
     heading = math.degrees(math.atan2(u[0], u[1]))
@@ -232,8 +234,8 @@ def test_quality_reports_reflector_rcs_and_calibrate_derives_k(rd, cli, tmp_path
 
 
 class _Plane:
-    """Terrain rising toward the radar with slope alpha: height = tan(alpha) x (the horizontal distance from
-    a point toward the radar), in a local tangent plane (east/north metres from lat0, lon0)."""
+    """Terrain facing the radar with slope alpha (rising AWAY from it): height = tan(alpha) x (the horizontal
+    distance from a point away from the radar), in a local tangent plane (east/north metres from lat0, lon0)."""
 
     def __init__(self, lat0, lon0, toward_e, toward_n, alpha):
         self.lat0, self.lon0, self.e, self.n, self.k = lat0, lon0, toward_e, toward_n, math.tan(alpha)
@@ -267,7 +269,7 @@ def test_gamma0_flattening_of_a_plane(rd, alpha_deg):
     lat0, lon0, _ = (float(x) for x in ecef_to_geodetic(p0))
     sat, _ = platform_state(rd.orbit, rd.epoch_utc, np.array([t0]))
     u = enu_basis(lat0, lon0).T @ (sat[0] - p0)
-    h = u[:2] / np.linalg.norm(u[:2])
+    h = -u[:2] / np.linalg.norm(u[:2])  # horizontal, away from the radar
     alpha = math.radians(alpha_deg)
     ratio = flattening(rd, la, lr, (n, m), _Plane(lat0, lon0, h[0], h[1], alpha))
     inner = ratio[n // 4: 3 * n // 4, m // 4: 3 * m // 4]
