@@ -188,10 +188,9 @@ def _reflector_csv(slc, path: Path, rcs_m2: float) -> None:
     """A NISAR corner-reflector CSV with one trihedral on the scene's point target, its boresight on the line
     of sight (CSV angles as ISCE3 reads them: azimuth = boresight heading from east, clockwise; tilt =
     boresight elevation - 35.26 deg), its side making ``rcs_m2`` = 4 pi a^4 / (3 lam^2)."""
+    from orbit.geodetic import geodetic_to_ecef
     from sarcli.calibration.predict import image_orbit
     from sarcli.calibration.reflectors import enu_basis
-
-    from orbit.geodetic import geodetic_to_ecef
 
     tg = slc.truth["targets"][0]
     p = np.asarray(geodetic_to_ecef(tg["lat_deg"], tg["lon_deg"], tg["height_m"]), np.float64)
