@@ -275,3 +275,19 @@ def test_gamma0_flattening_of_a_plane(rd, alpha_deg):
     assert np.isfinite(inner).all()
     theta = float(node_geometry(rd, np.array([t0]), np.array([r0]), 0.0).incidence[0, 0])
     assert np.mean(inner) == pytest.approx(math.tan(theta - alpha), rel=0.02)
+
+
+def test_nisar_rslc_export_carries_the_luts(rd, cli, tmp_path):
+    import h5py
+
+    out = tmp_path / "rslc.h5"
+    r = cli("export", rd.parameters["path"], "--format", "nisar-rslc", "-o", out)
+    assert r.exit_code == 0, r.stderr
+    cal = rd.calibration
+    with h5py.File(out) as f:
+        ci = f["science/LSAR/RSLC/metadata/calibrationInformation"]
+        for name in ("beta0", "sigma0", "gamma0"):
+            np.testing.assert_allclose(ci["geometry"][name][()], getattr(cal, name), rtol=1e-6)
+        np.testing.assert_allclose(ci["geometry/slantRange"][()], cal.slant_range)
+        np.testing.assert_allclose(ci["frequencyA/HH/nes0"][()], cal.nes0, rtol=1e-6)
+        assert ci["absoluteCalibrationConstant"][()] == cal.constant
