@@ -9,7 +9,7 @@ One equation carries the whole chain [Freeman1992, eq. 5; ESA-S1-Cal]:
 
 ``L_beta0``, ``L_sigma0 = L_beta0 sin(theta_i)``, ``L_gamma0 = L_beta0 tan(theta_i)`` are look-up tables on a
 coarse (zero-Doppler time, slant range) grid (:class:`sarcli.model.slc.Calibration`), multiplicative as in
-NISAR's RSLC ``calibrationInformation/geometry`` [NISAR-RSLC-SPEC]. K is one absolute calibration constant
+NISAR's RSLC ``calibrationInformation/geometry`` [NISAR-RSLC]. K is one absolute calibration constant
 per product (the transmitted power, the antenna's peak gains, the receiver gain, (4 pi)^3 and lambda^2 of
 the radar equation): 1 for sarcli's simulator (a unit radar), else unknown (relative radiometry, said so)
 until ``sarcli calibrate`` measures it on corner reflectors.
