@@ -375,12 +375,14 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
                                 intensity=sink.intensity(la, lr))
             products["quicklook"] = str(config.quicklook)
         slc_hashed()
-    inten = sink.intensity(config.looks_az, config.looks_rg) if geotiffs else None
-    if geotiffs and config.radiometry:
-        from sarcli.calibration.products import radiometric_intensity
+    inten = None
+    if geotiffs:
+        inten = sink.intensity(config.looks_az, config.looks_rg)
+        if config.radiometry:
+            from sarcli.calibration.products import radiometric_intensity
 
-        inten, tags = radiometric_intensity(slc, inten, config.looks_az, config.looks_rg, config.radiometry, terrain,
-                                            config.noise_subtraction, tags)
+            inten, tags = radiometric_intensity(slc, inten, config.looks_az, config.looks_rg, config.radiometry,
+                                                terrain, config.noise_subtraction, tags)
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 

@@ -41,6 +41,7 @@ a space or a ``T`` and fractional seconds, missing optional items (attitude, Dop
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from collections.abc import Mapping
@@ -610,7 +611,8 @@ def _radar(f: h5py.File, fg: h5py.Group, r: np.ndarray, path: Path) -> Radar:
     if text(f.attrs.get("product_type", b"")) == PRODUCT_TYPE and "sarcli_radar" in f.attrs:
         kw = json.loads(text(f.attrs["sarcli_radar"]))
         kw["receiver_offsets_m"] = tuple(kw.get("receiver_offsets_m", (0.0,)))
-        kw = {k: (np.nan if v is None and k != "platform_velocity_mps" else v) for k, v in kw.items()}
+        optional = {fl.name for fl in dataclasses.fields(Radar) if fl.default is None}
+        kw = {k: (np.nan if v is None and k not in optional else v) for k, v in kw.items()}
         return Radar(**kw)
     fc_name = "processedCenterFrequency" if "processedCenterFrequency" in fg else "acquiredCenterFrequency"
     fc = number(fg, fc_name, path, positive=True)
