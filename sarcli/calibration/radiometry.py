@@ -373,7 +373,7 @@ def annotate(slc: SLC, raw, n_raw_samples: int | None = None) -> Calibration | N
     algorithm whose gain is not modelled)."""
     try:
         return calibrate(slc, noise_power(raw), n_raw_samples=n_raw_samples)
-    except SarcliError as e:
+    except ValueError as e:  # sarcli's and orbit's one-line errors (a geometry the solver cannot place)
         warnings.warn(f"no radiometric calibration: {e}", stacklevel=2)
         return None
 

@@ -55,8 +55,8 @@ class Radar:
     receiver_offsets_m: tuple[float, ...] = (0.0,)
     platform_velocity_mps: float | None = None
     #: the antenna, when the product knows it (radiometry, :mod:`sarcli.calibration.radiometry`): azimuth
-    #: length and elevation height (m) of a uniformly illuminated aperture, boresight look angle off the
-    #: geodetic nadir (rad)
+    #: length and elevation height (m) of a uniformly illuminated aperture (0: uniform illumination, the
+    #: pattern of a zero-size aperture), boresight look angle off the geodetic nadir (rad)
     antenna_length_m: float | None = None
     antenna_height_m: float | None = None
     antenna_look_angle_rad: float | None = None
