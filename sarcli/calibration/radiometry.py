@@ -2,7 +2,7 @@
 
 Notation: DN the SLC pixel, beta0 the radar brightness (backscatter per unit area in the slant plane),
 sigma0 = beta0 sin(theta_i) and gamma0 = beta0 tan(theta_i) with theta_i the incidence angle on the
-ellipsoid raised to the focusing height (terrain-flattened gamma0 over a DEM: :mod:`sarcli.calibration.terrain`).
+ellipsoid raised to the focusing height (terrain-flattened gamma0 over a DEM: :mod:`sarcli.calibration.products`).
 One equation carries the whole chain [Freeman1992, eq. 5; ESA-S1-Cal]:
 
     E|DN|^2 = K F(R, t) beta0,        beta0 = |DN|^2 * L_beta0,   L_beta0 = 1 / (K F)
@@ -22,8 +22,9 @@ a h(x), and a field of scatterers of mean backscatter sigma0 per ground area giv
 E|DN|^2 = sigma0 int |h|^2 dA_ground = beta0 E dr dx, E = sum over pixels of |h|^2 (the integrated energy
 of a unit point target), dr the slant-range spacing and dx = V_g / PRF the line spacing on the ground
 (V_g the ground speed of the zero-Doppler point): dA_ground = dr dx / sin(theta_i) and beta0 = sigma0 /
-sin(theta_i). The same E makes the integrated-energy RCS of a point target (:func:`point_rcs`):
-sigma = sum |DN|^2 dr dx / (K F / beta0-units) [Gray1990]. E separates into range and azimuth:
+sin(theta_i). The same E gives the integrated-energy RCS of a point target (:func:`point_rcs`):
+sum |DN|^2 = K F sigma / (dr dx), i.e. sigma = sum(|DN|^2 L_beta0) dr dx [Gray1990]. E separates into
+range and azimuth:
 
 - range, matched filter H = conj(S_ref) W(f / (a B)) / sum|ref|^2 (:func:`sarcli.focus.rangecomp.range_filter`),
   chirp of band B = |K_r| T, N_r = T fs samples; stationary phase |S_ref(f)|^2 = fs^2 / |K_r| inside B:
