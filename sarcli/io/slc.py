@@ -23,7 +23,8 @@ Layout (SI units)::
                            :mod:`sarcli.calibration.radiometry`) on nodes azimuth_time x slant_range:
                            beta0, sigma0, gamma0 (multiplicative: beta0 = |DN|^2 * beta0), nes0 (noise-
                            equivalent sigma0, linear); attributes constant (K), applied / not_applied
-                           (JSON lists of the model's terms), details (JSON)
+                           (JSON lists of the model's terms), details (JSON); nes0_per_sample
+                           (n_samples,) the noise floor of every column (on /slant_range)
     /timings               attributes: seconds per processing stage
 
 Times are ``seconds since <epoch_utc>`` (CF); /image's axes are the dimension scales /azimuth_time and
@@ -156,14 +157,16 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
     if s.truth is not None:
         write_mapping(f, "truth", s.truth, s.epoch_utc)
     if s.calibration is not None:
-        write_calibration(f, s.calibration, tunits)
+        write_calibration(f, s.calibration, tunits, np.asarray(s.slant_range, np.float64))
     tg = group(f, "timings")
     for k, v in sorted(s.timings.items()):
         tg.attrs[k] = float(v)
 
 
-def write_calibration(f: h5py.Group, cal: Calibration, tunits: str) -> None:
-    """The /calibration group (module docstring), replacing one that is there."""
+def write_calibration(f: h5py.Group, cal: Calibration, tunits: str, slant_range: np.ndarray | None = None) -> None:
+    """The /calibration group (module docstring), replacing one that is there; with the image's
+    ``slant_range`` also ``nes0_per_sample``: the noise floor at every column (the nodes' mean over
+    time, linear in range between nodes)."""
     if "calibration" in f:
         del f["calibration"]
     g = group(f, "calibration")
@@ -180,6 +183,12 @@ def write_calibration(f: h5py.Group, cal: Calibration, tunits: str) -> None:
                        ("gamma0", "gamma0 per |DN|^2 (ellipsoid incidence)"),
                        ("nes0", "noise-equivalent sigma0 (linear)")):
         dataset(g, name, np.asarray(getattr(cal, name), np.float64), units="1", description=desc, dims=(t, r))
+    if slant_range is not None and "slant_range" in f:
+        with np.errstate(invalid="ignore"):
+            per = np.interp(slant_range, cal.slant_range, np.mean(cal.nes0, axis=0))
+        ds = dataset(g, "nes0_per_sample", per, units="1",
+                     description="noise-equivalent sigma0 (linear) of every image column, mean over time")
+        ds.dims[0].attach_scale(f["slant_range"])
 
 
 def read_calibration(g: h5py.Group, path) -> Calibration:

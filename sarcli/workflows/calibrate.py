@@ -90,7 +90,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         with atomic_path(out) as tmp:
             shutil.copyfile(config.slc, tmp)
             with h5py.File(tmp, "r+") as f:
-                write_calibration(f, cal, cf_time_units(slc.epoch_utc))
+                write_calibration(f, cal, cf_time_units(slc.epoch_utc), slc.slant_range)
     spread = float(np.std(err)) if err.size > 1 else 0.0
     recs = [{"id": r.id, "rcs_dbsm": r.rcs_dbsm, "rcs_theory_dbsm": r.rcs_theory_dbsm,
              "rcs_error_db": r.rcs_error_db} for r in used]

@@ -162,6 +162,12 @@ def test_rd_noise_floor_is_the_sigma0_of_noise_only_pixels(rd):
     product = np.mean(lut_on(rd.calibration, "nes0", t, r))
     assert rd.calibration.details["noise_power"] == p_n
     assert abs(10 * np.log10(measured / product)) < 1.0
+    import h5py
+
+    with h5py.File(rd.parameters["path"]) as f:  # the noise floor per column, beside the image
+        per = f["calibration/nes0_per_sample"][()]
+    assert per.shape == rd.slant_range.shape
+    assert 10 * np.log10(np.mean(per[cols]) / product) == pytest.approx(0.0, abs=0.05)
 
 
 @pytest.mark.parametrize("options", [
