@@ -47,16 +47,19 @@ def flattening(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int], t
     n, m = shape
     t, r = _look_axes(slc, looks_az, looks_rg, shape)
     lam = slc.radar.wavelength_m
-    # footprint and lattice spacing from the image corners on the DEM
+    # footprint: the image corners on the ellipsoid, widened by 4 pixels and by the ground shift of the
+    # highest and lowest terrain there (h / tan(incidence)); the lattice at half a pixel
     tt, rr = np.meshgrid(t[[0, -1]], r[[0, -1]], indexing="ij")
-    corners = zero_doppler_points(slc.orbit, slc.epoch_utc, tt, rr, lam, slc.look_side, terrain).reshape(-1, 3)
-    lat, lon, _ = ecef_to_geodetic(corners)
+    corners = zero_doppler_points(slc.orbit, slc.epoch_utc, tt, rr, lam, slc.look_side, ConstantHeight(0.0))
+    lat, lon, _ = ecef_to_geodetic(corners.reshape(-1, 3))
     prf = float(slc.parameters.get("prf_hz") or slc.prf_hz)
-    geo = node_geometry(slc, t[[n // 2]], r[[m // 2]], 0.0)
-    dx = float(geo.v_g[0, 0]) / prf * looks_az
-    dg = slc.range_spacing_m * looks_rg / float(np.sin(geo.incidence[0, 0]))
+    geo = node_geometry(slc, t[[0, n // 2]], r[[0, m // 2]], 0.0)
+    dx = float(geo.v_g[1, 1]) / prf * looks_az
+    dg = slc.range_spacing_m * looks_rg / float(np.sin(geo.incidence[1, 1]))
     step_m = 0.5 * min(dx, dg)
-    pad = 4.0 * max(dx, dg) / 111e3
+    cla, clo = np.meshgrid(np.linspace(lat.min(), lat.max(), 33), np.linspace(lon.min(), lon.max(), 33), indexing="ij")
+    relief = float(np.max(np.abs(np.asarray(terrain.height(cla, clo), np.float64))))
+    pad = (4.0 * max(dx, dg) + 1.2 * relief / np.tan(float(geo.incidence[0, 0]))) / 111e3
     lat0, lat1 = float(lat.min()) - pad, float(lat.max()) + pad
     lon0, lon1 = float(lon.min()) - pad, float(lon.max()) + pad
     coslat = max(np.cos(np.radians(0.5 * (lat0 + lat1))), 0.05)
@@ -73,6 +76,13 @@ def flattening(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int], t
     bad = np.zeros(n * m, bool)
     hit = np.zeros(n * m, bool)
     t_mid = float(0.5 * (slc.azimuth_time[0] + slc.azimuth_time[-1]))
+    # the orientation a facet of FLAT ground has in radar coordinates (the lattice's centre cell at height 0):
+    # a facet whose orientation is reversed is in layover
+    ic, jc = n_lat // 2, n_lon // 2
+    flat = geodetic_to_ecef(la[ic:ic + 2, jc:jc + 2], lo[ic:ic + 2, jc:jc + 2], np.zeros((2, 2)))
+    ref = [doppler_time(sv, v.reshape(1, 3), t_guess=np.array([t_mid])) for v in (flat[0, 0], flat[0, 1], flat[1, 1])]
+    flat_sign = np.sign(((ref[1][0] - ref[0][0]) * (ref[2][1] - ref[0][1])
+                         - (ref[1][1] - ref[0][1]) * (ref[2][0] - ref[0][0]))[0])
     for v0, v1, v2 in tris:
         cen = ((v0 + v1 + v2) / 3.0).reshape(-1, 3)
         nvec = 0.5 * np.cross(v1 - v0, v2 - v0).reshape(-1, 3)
@@ -90,7 +100,6 @@ def flattening(slc: SLC, looks_az: int, looks_rg: int, shape: tuple[int, int], t
             tv, rv = doppler_time(sv, v.reshape(-1, 3)[inside], t_guess=tz[inside])
             rad.append((tv, rv))
         jac = (rad[1][0] - rad[0][0]) * (rad[2][1] - rad[0][1]) - (rad[1][1] - rad[0][1]) * (rad[2][0] - rad[0][0])
-        flat_sign = np.sign(np.median(jac))
         k = row[inside] * m + col[inside]
         area += np.bincount(k, weights=np.maximum(proj, 0.0), minlength=n * m)
         bad |= np.bincount(k, weights=((proj <= 0.0) | (np.sign(jac) != flat_sign)).astype(float),

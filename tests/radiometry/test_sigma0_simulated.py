@@ -283,6 +283,27 @@ def test_gamma0_flattening_of_a_plane(rd, alpha_deg):
     assert np.mean(inner) == pytest.approx(math.tan(theta - alpha), rel=0.02)
 
 
+@pytest.mark.parametrize("alpha_deg", [45.0, -56.0])
+def test_gamma0_masks_layover_and_shadow(rd, alpha_deg):
+    """Facing the radar steeper than the incidence (39 deg): layover; facing away steeper than its
+    complement (51 deg): shadow. Every interior pixel is nodata."""
+    from orbit.geodetic import ecef_to_geodetic
+    from sarcli.calibration.products import flattening
+    from sarcli.calibration.reflectors import enu_basis
+    from sarcli.focus.geolocation import platform_state, zero_doppler_points
+
+    la, lr = 16, 16
+    n, m = rd.azimuth_time.size // la, rd.slant_range.size // lr
+    t0, r0 = rd.azimuth_time[n * la // 2], rd.slant_range[m * lr // 2]
+    p0 = zero_doppler_points(rd.orbit, rd.epoch_utc, t0, r0, rd.radar.wavelength_m, rd.look_side)
+    lat0, lon0, _ = (float(x) for x in ecef_to_geodetic(p0))
+    sat, _ = platform_state(rd.orbit, rd.epoch_utc, np.array([t0]))
+    u = enu_basis(lat0, lon0).T @ (sat[0] - p0)
+    h = -u[:2] / np.linalg.norm(u[:2])
+    ratio = flattening(rd, la, lr, (n, m), _Plane(lat0, lon0, h[0], h[1], math.radians(alpha_deg)))
+    assert np.isnan(ratio[n // 4: 3 * n // 4, m // 4: 3 * m // 4]).all()
+
+
 def test_nisar_rslc_export_carries_the_luts(rd, cli, tmp_path):
     import h5py
 
