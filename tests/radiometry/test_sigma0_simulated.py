@@ -318,3 +318,32 @@ def test_nisar_rslc_export_carries_the_luts(rd, cli, tmp_path):
         np.testing.assert_allclose(ci["geometry/slantRange"][()], cal.slant_range)
         np.testing.assert_allclose(ci["frequencyA/HH/nes0"][()], cal.nes0, rtol=1e-6)
         assert ci["absoluteCalibrationConstant"][()] == cal.constant
+
+
+def test_sigma0_geotiff_with_noise_subtraction(raw_path, rd, cli, tmp_path):
+    """``focus --geotiff-slant --radiometry sigma0 --noise-subtraction``: band 2 in dB with its units and the
+    radiometry in the tags; the mid patch's mean sigma0 (linear mean of the looks, noise subtracted) as stated."""
+    import rasterio
+
+    clutter, _, _ = _stated()
+    tr = rd.truth
+    tif = tmp_path / "s0.tif"
+    r = cli("focus", raw_path, "-o", tmp_path / "slc.h5", "--fdc", str(float(np.median(tr["doppler_centroid_hz"]))),
+            "--fr", str(float(np.median(tr["doppler_rate_hz_per_s"]))), "--geotiff-slant", tif, "--radiometry",
+            "sigma0", "--noise-subtraction", "--looks-az", "4", "--looks-rg", "3")
+    assert r.exit_code == 0, r.stderr
+    assert "not applied" not in r.stderr
+    with rasterio.open(tif) as ds:
+        tags = ds.tags()
+        assert ds.units == ("1", "dB") and tags["RADIOMETRY"] == "sigma0" and tags["NOISE_SUBTRACTED"] == "yes"
+        assert tags["RADIOMETRY_NOT_APPLIED"] == "none" and tags["CALIBRATION_CONSTANT_K"] == "1"
+        assert float(tags["NESZ_SIGMA0_DB_MEDIAN"]) == pytest.approx(10 * np.log10(np.nanmedian(rd.calibration.nes0)),
+                                                                     abs=0.01)
+        db = ds.read(2)
+    sin_inc = float(np.nanmedian(rd.calibration.sigma0 / rd.calibration.beta0))
+    r0 = _closest_range(rd, clutter[1]["slant_range_m"])
+    half = 0.5 * clutter[1]["range_extent_m"] * sin_inc
+    cols = np.flatnonzero(np.abs(rd.slant_range[: db.shape[1] * 3].reshape(-1, 3).mean(axis=1) - r0) < 0.6 * half)
+    rows = _rows(rd, _target(rd, _closest_range(rd, _stated()[1]["slant_range_m"]))[0])
+    lin = 10.0 ** (db[rows.start // 4: rows.stop // 4, cols] / 10.0)
+    assert abs(10 * np.log10(np.nanmean(lin)) - clutter[1]["sigma0_db"]) < 0.3
