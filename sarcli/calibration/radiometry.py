@@ -346,9 +346,13 @@ def calibrate(slc: SLC, noise: tuple[float | None, str] = (None, "not given"), c
     if not has_orbit:
         missing.append(TERM_GEOMETRY)
     if constant is None:
-        if slc.source in NO_SPREADING_SOURCES:
+        if slc.source in NO_SPREADING_SOURCES and not slc.radar.quantization_bits:
             constant = SIMULATED_CONSTANT
             applied.append(TERM_CONSTANT + " (1: the simulator's unit radar)")
+        elif slc.source in NO_SPREADING_SOURCES:
+            constant = 1.0
+            missing.append(TERM_CONSTANT + " (the simulated receiver gain before the quantizer is not in the "
+                           "product: relative radiometry)")
         else:
             constant = 1.0
             missing.append(TERM_CONSTANT + " (relative radiometry: run sarcli calibrate)")
