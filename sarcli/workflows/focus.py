@@ -82,9 +82,13 @@ class Config:
     workers: int | None = None
     threads_per_worker: int = 1
     scheduler: str | None = None
+    radiometry: Literal["beta0", "sigma0", "gamma0"] | None = None
+    noise_subtraction: bool = False
 
     def __post_init__(self) -> None:
         self.cluster()  # checked when the configuration is made
+        if self.radiometry is not None and self.radiometry not in ("beta0", "sigma0", "gamma0"):
+            raise ConfigError(f"--radiometry must be beta0, sigma0 or gamma0, got {self.radiometry!r}")
         if self.looks_az < 1 or self.looks_rg < 1:
             raise ConfigError(f"--looks-az and --looks-rg must be at least 1, got {self.looks_az} and {self.looks_rg}")
         if self.pixel_spacing_m is not None and not (math.isfinite(self.pixel_spacing_m) and self.pixel_spacing_m > 0):
@@ -334,6 +338,9 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
             echo = load_echo().channel(ch) if focuser.streams else plan_raw.echo
             slc = run_blocks(focuser, plan, lambda a, b: echo[a:b], sink, on_block)
         slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": config.stored()}
+        from sarcli.calibration.radiometry import annotate
+
+        slc.calibration = annotate(slc, load_echo.raw or raw, shape[1])
         meta.update_from(slc)
     return slc, sink
 
@@ -373,20 +380,28 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
                                 intensity=sink.intensity(la, lr))
             products["quicklook"] = str(config.quicklook)
         slc_hashed()
+    inten = None
+    if geotiffs:
+        inten = sink.intensity(config.looks_az, config.looks_rg)
+        if config.radiometry:
+            from sarcli.calibration.products import radiometric_intensity
+
+            inten, tags = radiometric_intensity(slc, inten, config.looks_az, config.looks_rg, config.radiometry,
+                                                terrain, config.noise_subtraction, tags)
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 
         write_slant_geotiff(config.geotiff_slant, slc, config.looks_az, config.looks_rg, tags, terrain,
-                            inputs=(config.output,), intensity=sink.intensity(config.looks_az, config.looks_rg),
-                            compression=config.geotiff_compression)
+                            inputs=(config.output,), intensity=inten,
+                            compression=config.geotiff_compression, radiometry=config.radiometry)
         products["geotiff_slant"] = str(config.geotiff_slant)
     if config.geotiff:
         from sarcli.focus.geocode import write_map_geotiff
 
         used = write_map_geotiff(config.geotiff, slc, config.looks_az, config.looks_rg, config.crs,
                                  config.pixel_spacing_m, tags, terrain, inputs=(config.output,),
-                                 intensity=sink.intensity(config.looks_az, config.looks_rg),
-                                 compression=config.geotiff_compression)
+                                 intensity=inten, compression=config.geotiff_compression,
+                                 radiometry=config.radiometry)
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
     return products

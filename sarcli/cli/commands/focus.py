@@ -70,6 +70,11 @@ def focus(
     looks_az: int = typer.Option(1, "--looks-az", help="Azimuth looks for the GeoTIFFs/quicklook."),
     looks_rg: int = typer.Option(1, "--looks-rg", help="Range looks for the GeoTIFFs/quicklook."),
     quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the amplitude (dB)."),
+    radiometry: str = typer.Option(None, "--radiometry", metavar="[beta0|sigma0|gamma0]",
+                                   help="GeoTIFFs in calibrated backscatter (dB band, units in the tags); gamma0 "
+                                   "terrain-flattened over --dem."),
+    noise_subtraction: bool = typer.Option(False, "--noise-subtraction", help="Subtract the noise floor (NESZ) "
+                                           "from the --radiometry GeoTIFFs."),
     workers: int = typer.Option(None, "--workers", help="Focus the blocks in parallel on a local Dask cluster of "
                                 "this many processes (the same image)."),
     scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
@@ -106,6 +111,8 @@ def focus(
       sarcli focus big_raw.h5 -o slc.h5 --fdc -6690 --fr -1990 --workers 2
 
       sarcli focus raw.h5 -o slc.h5 --device cuda    # on the GPU (pip install 'sarcli[gpu]')
+
+      sarcli focus raw.h5 -o slc.h5 --geotiff sigma0.tif --radiometry sigma0 --looks-az 4
     """
     given = {"range_window": range_window, "azimuth_window": azimuth_window, "azimuth_bandwidth": azimuth_bandwidth,
              "range_band_fraction": range_band_fraction, "rcmc": rcmc, "rcmc_oversample": rcmc_oversample,
@@ -126,7 +133,7 @@ def focus(
                     crs=crs, pixel_spacing_m=spacing,
                     looks_az=looks_az, looks_rg=looks_rg, channel=channel,
                     accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler,
-                    device=_device(device))
+                    radiometry=radiometry, noise_subtraction=noise_subtraction, device=_device(device))
     with progress_bar(1, label="focusing") as bar:
         def progress(label: str, done: int, total: int) -> None:
             bar.length = total
