@@ -460,6 +460,7 @@ class ChirpScaling(RangeDoppler):
     output grid, model grid and per-line corrections (:meth:`RangeDoppler.line_corrections`)."""
 
     name = "csa"
+    azimuth_compression = "frequency"  # its processing gain (sarcli.calibration.radiometry)
     Options = CsaOptions  # type: ignore[assignment]  # a focuser's own knobs (base.Focuser.Options: type)
     streams = True
     needs_doppler = True

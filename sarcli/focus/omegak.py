@@ -422,6 +422,7 @@ class Omegak(RangeDoppler):
     grid, model, per-line corrections and metadata (``finish``); its blocks are the module docstring's."""
 
     name = "omegak"
+    azimuth_compression = "frequency"  # its processing gain (sarcli.calibration.radiometry)
     Options = OmegakOptions
 
     def plan(self, raw: RawProduct, shape: tuple[int, int], doppler, options: OmegakOptions,

@@ -347,3 +347,16 @@ def test_sigma0_geotiff_with_noise_subtraction(raw_path, rd, cli, tmp_path):
     rows = _rows(rd, _target(rd, _closest_range(rd, _stated()[1]["slant_range_m"]))[0])
     lin = 10.0 ** (db[rows.start // 4: rows.stop // 4, cols] / 10.0)
     assert abs(10 * np.log10(np.nanmean(lin)) - clutter[1]["sigma0_db"]) < 0.3
+
+
+@pytest.mark.parametrize("algorithm", ["csa", "omegak"])
+def test_fft_focusers_sigma0_and_point_target(raw_path, algorithm):
+    """csa and omegak declare RD's frequency-domain azimuth compression and keep RD's range scale: the same
+    radiometric model must then give the stated sigma0 and RCS within the same bars."""
+    from sarcli.calibration.radiometry import point_rcs
+
+    slc = _focus(raw_path, algorithm)
+    _check_scene(slc)
+    _, target, _ = _stated()
+    i, j = _target(slc, _closest_range(slc, target["slant_range_m"]))
+    assert abs(10 * np.log10(point_rcs(slc, i, j) / target["amplitude"] ** 2)) < 0.3
