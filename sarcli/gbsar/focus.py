@@ -103,7 +103,8 @@ class FocusOptions:
     ``grid_m``: (x0, x1, dx, y0, y1, dy[, z]) backprojects onto that horizontal grid instead (module
     docstring; ``auto`` means BP there, and the slant-grid options must stay unset);
     ``permittivity``: relative permittivity of the medium the waves travel in (>= 1); ``ffbp``: the
-    knobs of ``algorithm`` ffbp (:class:`sarcli.focus.ffbp.FfbpKnobs`).
+    knobs of ``algorithm`` ffbp (:class:`sarcli.focus.ffbp.FfbpKnobs`; aperture_split 64: a rail's footprint
+    apertures are short, so most of them are backprojected stop by stop, as BP does).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
@@ -123,7 +124,7 @@ class FocusOptions:
     rd_reference: Literal["sinc", "rect"] = "sinc"
     grid_m: tuple[float, ...] = ()
     permittivity: float = 1.0
-    ffbp: FfbpKnobs = FfbpKnobs()
+    ffbp: FfbpKnobs = FfbpKnobs(aperture_split=64)
 
     def __post_init__(self) -> None:
         if self.algorithm not in ALGORITHMS:
