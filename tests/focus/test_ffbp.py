@@ -279,3 +279,25 @@ def test_stripmap_blocks_give_the_same_image(rs1):
     # same samples and sums; only the polar grids' origins differ, so a sample's range r0 + i dr rounds
     # differently (1 ulp of 1e6 m: 2e-10 m, 5e-8 rad) and the complex64 output (6e-8) rounds with it
     assert np.abs(many.image - one.image).max() <= 1e-5 * np.abs(one.image).max()
+
+
+@pytest.mark.slow
+def test_cli_focus_ffbp(cli, tmp_path):
+    """``sarcli focus --algorithm ffbp`` end to end on a window of the e2e scene, its knobs through --set, a
+    bad knob refused in one line."""
+    from sarcli.io.raw import read_raw
+    from sarcli.io.slc import read_slc
+    from tests.focus.test_cli import SCENES
+
+    raw = tmp_path / "raw.h5"
+    assert cli("simulate", SCENES / "e2e.toml", "-o", raw).exit_code == 0
+    truth = read_raw(raw, load_echo=False).truth
+    mid = truth["doppler_centroid_hz"].size // 2
+    dop = ["--fdc", str(truth["doppler_centroid_hz"][mid]), "--fr", str(truth["doppler_rate_hz_per_s"][mid])]
+    r = cli("focus", raw, "-o", tmp_path / "ffbp.h5", "--algorithm", "ffbp", *dop, "--set", "lines=[0,32]",
+            "--set", "samples=[0,32]", "--set", "base=8")
+    assert r.exit_code == 0, r.stderr
+    slc = read_slc(tmp_path / "ffbp.h5")
+    assert slc.image.shape == (32, 32) and slc.algorithm == "ffbp" and slc.parameters["base"] == 8
+    bad = cli("focus", raw, "-o", tmp_path / "bad.h5", "--algorithm", "ffbp", *dop, "--set", "order=5")
+    assert bad.exit_code != 0 and "order must be 2, 4, 6 or 8" in bad.stderr and "Traceback" not in bad.stderr
