@@ -86,10 +86,13 @@ once in each axis, so at a scatterer's peak (all components coherent) the relati
     eps <= (S + 1) (e_order(beta) + e_range_order(U)),      S = merge stages (:func:`peak_error_bound`),
 
 a worst case (the whole spectrum at the band edge): windows weight the band's edges down, so measured
-errors are well below it (tests/focus/test_ffbp.py, bench/bench_gotcha.py). Block invariance: the
-subapertures are aligned to the global pulse index (``first_index``) and every polar sample is a pure
-function of its stencil, so a pixel's value does not depend on the other pixels of its block as long
-as the grids cover its stencil (margins below).
+errors are well below it (tests/focus/test_ffbp.py, bench/bench_ffbp.py). Block invariance: the
+subapertures are aligned to the global pulse index (``first_index``), the polar grids to global lattices
+(r0 and u0 multiples of the steps) and every polar sample is a function of its stencil only, so a
+pixel's value does not depend on the other pixels of its block (to the rounding of the samples'
+positions, r0 + i dr from different origins: 1e-5 of the peak measured) as long as the grids hold its
+stencil; where a top subaperture's grid does not hold a pixel, the last stage backprojects that
+subaperture there pulse by pulse.
 """
 
 from __future__ import annotations
@@ -601,7 +604,8 @@ def ffbp(lines: np.ndarray, r_first: float, dr: float, range_cell: float, wavele
     ``weights`` w_n, ``r_out`` (n1, n2) the output phase reference, ``first_index`` the global index of
     pulse 0 (subapertures align to it), ``plane`` (a point towards the scene centre, its normal) where the
     polar samples lie (default: fitted to the pixels; a block-independent one keeps blocks identical),
-    ``stats`` gets the stage count, the polar sample count and the stage times."""
+    ``stats`` gets the stage count, the polar sample counts (total, per level, largest grid per level) and
+    the stage times."""
     pix = np.ascontiguousarray(pixels, np.float64)
     n1, n2 = pix.shape[:2]
     pos = np.ascontiguousarray(pos, np.float64)

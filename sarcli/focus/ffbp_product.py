@@ -11,7 +11,7 @@ pulses at the pixel (exact at a scatterer's peak; a sidelobe-level term elsewher
 ``aperture_split`` rises). Block invariance: subapertures are aligned to the raw line index and a
 block reads whole top subapertures (its raw span widened to their edges), and the polar samples lie on
 one plane per plan (fitted to the whole output window), so a pixel's value does not depend on its
-block (tests/focus/test_ffbp.py).
+block (to rounding: 1e-5 of the peak, tests/focus/test_ffbp.py).
 """
 
 from __future__ import annotations
