@@ -152,8 +152,8 @@ class FocusOptions:
         if self.grid_m:
             self.plane_grid()
             if self.algorithm not in ("bp", "ffbp", "auto"):
-                raise ConfigError(f"--grid is a backprojection grid: use --algorithm bp or ffbp, not "
-                                  f"{self.algorithm}")
+                raise ConfigError(f"--grid is a backprojection grid: use --algorithm bp, not {self.algorithm} "
+                                  "(or ffbp)")
             slant = [flag for flag, value in (("--max-range", self.max_range_m), ("--pixel-x", self.pixel_x_m),
                                               ("--width", self.width_m), ("--n-xfft", self.n_xfft))
                      if value is not None] + (["--min-range"] if self.min_range_m else [])

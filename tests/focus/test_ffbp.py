@@ -185,6 +185,7 @@ def _peak_error(scene, knobs):
     return abs(img[i] - ex[i]) / abs(ex[i]), peak_error_bound(knobs, stats["merge_stages"], u_r)
 
 
+@pytest.mark.slow
 @settings(max_examples=12, deadline=None)
 @given(order=st.sampled_from([4, 6, 8]), beta=st.floats(1.5, 3.0), base=st.sampled_from([2, 4]),
        range_order=st.sampled_from([4, 6]))
