@@ -8,6 +8,7 @@ emulator): ``rd`` (:class:`sarcli.focus.rda.RangeDoppler`), ``csa`` (chirp scali
 (:class:`sarcli.focus.bp_product.Backprojection`) and ``optical`` (the AOD/CCD emulation,
 :mod:`sarcli.optical.focus_plugin`). Others register with ``FOCUSERS.register(name, obj)`` or an
 entry point in the ``sarcli.focusers`` group.
+Also built in: ``ffbp``, fast factorized backprojection (:class:`sarcli.focus.ffbp_product.Ffbp`).
 
 In memory: :func:`sarcli.focus.rda.focus_rd` ``(raw, doppler, channel=0, **options) -> SLC`` and
 :func:`sarcli.focus.base.focus_in_memory` for any focuser.
@@ -25,5 +26,6 @@ FOCUSERS: Registry = Registry("focuser", "sarcli.focusers", {
     "csa": "sarcli.focus.csa:CSA",
     "backprojection": "sarcli.focus.bp_product:BACKPROJECTION",
     "omegak": "sarcli.focus.omegak:OMEGAK",
+    "ffbp": "sarcli.focus.ffbp_product:FFBP",
     "optical": "sarcli.optical.focus_plugin:OPTICAL",
 }, check=check_focuser)

@@ -125,10 +125,8 @@ class Backprojection:
         raw, g, k = plan.raw, plan.grid, plan.options
         la, _, sa, sb = plan.window
         s, e = plan.block_rows(b)
-        n_lines = raw.azimuth_time.size
         nr = g.ranges.size
-        # output line j sees raw lines j + offset - shift +- aperture / 2: the RD overlap covers them
-        a, z = max(0, la + s - g.pad), min(n_lines, la + e + g.pad)
+        a, z = self.raw_span(plan, b)
         t0 = time.perf_counter()
         data = np.asarray(read_lines(a, z))
         if data.shape != (z - a, nr):
@@ -143,11 +141,25 @@ class Backprojection:
         pix = zero_doppler_points(raw.orbit, raw.epoch_utc, tt, rr, g.wavelength, raw.look_side, plan.terrain)
         pos, vel = platform_state(raw.orbit, raw.epoch_utc, raw.azimuth_time[a:z])
         fdc_pix = np.broadcast_to(plan.fdc[sa:sb][None, :], tt.shape).ravel()
-        img = backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
-                               pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
-                               k.upsample, k.precision, first_line=a, device=k.device).reshape(tt.shape)
+        img = self.image(plan, rc, a, pos, vel, pix, rr, fdc_pix)
         plan.timings["backprojection_s"] = plan.timings.get("backprojection_s", 0.0) + time.perf_counter() - t0
         return img.astype(np.complex64)
+
+    def raw_span(self, plan: BpPlan, b: int) -> tuple[int, int]:
+        """Raw lines [a, z) that block ``b`` reads: output line j sees raw lines j + offset - shift +-
+        aperture / 2, which the RD overlap covers."""
+        la, s, e, pad = plan.window[0], *plan.block_rows(b), plan.grid.pad
+        return max(0, la + s - pad), min(plan.raw.azimuth_time.size, la + e + pad)
+
+    def image(self, plan: BpPlan, rc: np.ndarray, a: int, pos: np.ndarray, vel: np.ndarray, pix: np.ndarray,
+              rr: np.ndarray, fdc_pix: np.ndarray) -> np.ndarray:
+        """The block's image from its range-compressed lines ``rc`` (raw lines from ``a``; positions and
+        velocities ``pos``, ``vel``) at the pixels ``pix`` (lines, samples, 3) of ranges ``rr``, centroids
+        ``fdc_pix`` (flat)."""
+        raw, g, k = plan.raw, plan.grid, plan.options
+        return backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
+                                pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
+                                k.upsample, k.precision, first_line=a, device=k.device).reshape(rr.shape)
 
     def finish(self, plan: BpPlan) -> SLC:
         raw, g = plan.raw, plan.grid

@@ -1,6 +1,6 @@
 """``gbsar_focus``: scan product -> focused image product (+ UTM / ENU GeoTIFFs and a quicklook).
 
-Range compression, then DF, RD, BP or ``auto`` (DF beyond the eq. 12 limit, BP or RD nearer); see
+Range compression, then DF, RD, BP, FFBP or ``auto`` (DF beyond the eq. 12 limit, BP or RD nearer); see
 :mod:`sarcli.gbsar.focus`. The image lies in the slant plane of the rail (range R0 from the rail line,
 azimuth x along it); its phase at a scatterer is ``-4 pi R0/lam`` for every algorithm. Everything
 that can be refused is refused before any focusing: an output that is the input, a missing output
@@ -42,7 +42,7 @@ class Config:
 
     scan: Path
     output: Path
-    algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
+    algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
     pols: tuple[str, ...] = ()
     max_range_m: float | None = None
     min_range_m: float = 0.0
@@ -97,7 +97,8 @@ class GbsarFocusReport(Report):
     def lines(self) -> list[str]:
         g = self.focus.get("grid")
         if g is not None:
-            return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, bp on the grid x "
+            return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, {next(iter(self.focus['used']))} "
+                    f"on the grid x "
                     f"{g['x_m'][0]:g}..{g['x_m'][1]:g} m, y {g['y_m'][0]:g}..{g['y_m'][1]:g} m at z {g['z_m']:g} m "
                     f"from {self.focus['n_sweeps']} sweeps ({self.focus['track']} track"
                     f"{', reference ranges' if self.focus['reference_range'] else ''}); "

@@ -31,7 +31,7 @@ def focus(
     accept_unresolved: bool = typer.Option(False, "--accept-unresolved-ambiguity",
                                            help="Use a Doppler model whose PRF ambiguity is unresolved."),
     algorithm: str = typer.Option("rd", "--algorithm", help="Focuser: rd (Range-Doppler), backprojection, "
-                                  "optical, or a plug-in."),
+                                  "ffbp (fast factorized backprojection), optical, or a plug-in."),
     channel: int = typer.Option(0, "--channel", help="Receive channel to focus (0 = /echo)."),
     height: float = typer.Option(0.0, "--height", help="Terrain height above the WGS-84 ellipsoid, m (default 0)."),
     dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),

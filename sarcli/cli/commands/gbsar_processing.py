@@ -121,7 +121,8 @@ def plan_cmd(
 def focus_cmd(
     scan: Path = typer.Argument(..., help="Scan product (.h5)."),
     output: Path = typer.Option(..., "-o", "--output", help="Output image product (.h5)."),
-    algorithm: str = typer.Option("auto", "--algorithm", metavar="[auto|df|rd|bp]", help="auto | df | rd | bp."),
+    algorithm: str = typer.Option("auto", "--algorithm", metavar="[auto|df|rd|bp|ffbp]",
+                                  help="auto | df | rd | bp | ffbp (fast factorized backprojection)."),
     pol: list[str] = typer.Option(None, "--pol", help="Polarization(s) to focus [default: all]."),
     max_range: float = typer.Option(None, "--max-range", help="Largest image range R0 (m) [default: R_max]."),
     min_range: float = typer.Option(0.0, "--min-range", help="Smallest image range R0 (m)."),
