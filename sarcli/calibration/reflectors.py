@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sarcli.errors import FormatError, ProductError
+from sarcli.errors import FormatError, MissingFileError
 
 NISAR_COLUMNS = ("id", "latitude_deg", "longitude_deg", "height_m", "azimuth_deg", "tilt_deg", "side_length_m",
                  "survey_utc", "validity", "velocity_east_mps", "velocity_north_mps", "velocity_up_mps")
@@ -73,7 +73,7 @@ def parse_reflectors(path: str | os.PathLike) -> list[CornerReflector]:
 
     path = Path(path)
     if not path.is_file():
-        raise ProductError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:

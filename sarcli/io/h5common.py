@@ -37,7 +37,7 @@ import h5py
 import numpy as np
 
 from sarcli import __version__
-from sarcli.errors import ProductError
+from sarcli.errors import MissingFileError, ProductError
 from sarcli.io.atomic import atomic_path, readable_name
 from sarcli.io.provenance import current
 from sarcli.model import checks as ck
@@ -500,7 +500,7 @@ def open_product(path: str | os.PathLike, product_type: str | Sequence[str] | No
     """
     path = Path(path)
     if not path.exists():
-        raise ProductError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     if path.is_file():
         probe_metadata(path)
     try:

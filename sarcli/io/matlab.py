@@ -47,7 +47,7 @@ import numpy as np
 import scipy.io
 
 from orbit.timeutil import format_utc, parse_utc
-from sarcli.errors import ConfigError, FormatError
+from sarcli.errors import ConfigError, FormatError, MissingFileError
 from sarcli.io.ceos.radarsat1.samples import is_four_bit
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import Radar, RawProduct
@@ -67,7 +67,7 @@ _REQUIRED = ("f0", "Fr", "Kr", "Tr", "PRF", "R0", "c")
 
 def _load(path: Path, what: str) -> dict[str, Any]:
     if not path.is_file():
-        raise FormatError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     try:
         return scipy.io.loadmat(path, squeeze_me=True)
     except NotImplementedError:

@@ -57,7 +57,7 @@ def test_export_refuses_overwriting_its_input_and_missing_files(cli, slc_file, t
     r = cli("export", slc_file, "-o", slc_file)
     assert r.exit_code == 2 and "refusing to overwrite an input" in r.stderr
     r = cli("export", tmp_path / "absent.h5", "-o", tmp_path / "x.h5")
-    assert r.exit_code == 1 and "no such file" in r.stderr
+    assert r.exit_code == 2 and "no such file" in r.stderr
 
 
 def test_a_plugin_format_is_used_without_changing_the_command(cli, slc_file, tmp_path):
