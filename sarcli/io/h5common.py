@@ -174,7 +174,8 @@ def to_jsonable(obj: Any) -> Any:
     return obj
 
 
-def _reproducible() -> bool:
+def reproducible() -> bool:
+    """Whether ``SOURCE_DATE_EPOCH`` is set: products then store nothing that depends on the clock."""
     return bool(os.environ.get("SOURCE_DATE_EPOCH", "").strip())
 
 

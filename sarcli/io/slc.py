@@ -19,7 +19,7 @@ Layout (SI units)::
     /geolocation_grid      Earth orbits only: longitude, latitude, incidence_angle, look_angle (degrees) on
                            (height, azimuth_time, slant_range) nodes; root ``bounding_polygon`` (WKT)
     /truth                 copied from a simulated raw product (``sarcli quality`` compares with it)
-    /timings               attributes: seconds per processing stage
+    /timings               attributes: seconds per processing stage (absent under SOURCE_DATE_EPOCH)
 
 Times are ``seconds since <epoch_utc>`` (CF); /image's axes are the dimension scales /azimuth_time and
 /slant_range, so ``xarray.open_dataset(path, engine="h5netcdf")`` labels it (docs/products.md).
@@ -49,6 +49,7 @@ from sarcli.io.h5common import (
     open_product,
     read_array,
     read_mapping,
+    reproducible,
     require,
     to_jsonable,
     write_mapping,
@@ -150,9 +151,10 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
     _write_geolocation(f, s, tunits)
     if s.truth is not None:
         write_mapping(f, "truth", s.truth, s.epoch_utc)
-    tg = group(f, "timings")
-    for k, v in sorted(s.timings.items()):
-        tg.attrs[k] = float(v)
+    if not reproducible():  # wall-clock seconds: left out under SOURCE_DATE_EPOCH (byte-identical files)
+        tg = group(f, "timings")
+        for k, v in sorted(s.timings.items()):
+            tg.attrs[k] = float(v)
 
 
 #: bytes of one ``/image`` chunk at most (HDF5's default chunk cache is 1 MiB: a chunk that a block

@@ -268,3 +268,27 @@ def test_the_slc_is_hashed_once_beside_the_quicklook(small, tmp_path, monkeypatc
     assert len(reads) == 1 and reads[0].startswith("sarcli-sha256"), reads
     with rasterio.open(tmp_path / "m.tif") as d:
         assert json.loads(d.tags()["INPUTS"]) == [{"path": "slc.h5", "sha256": _sha(tmp_path / "slc.h5")}]
+
+
+def test_focus_is_byte_identical_under_source_date_epoch(small, tmp_path, monkeypatch):
+    """README: with SOURCE_DATE_EPOCH set, products are byte-identical between runs. focus twice: the SLC
+    (no wall-clock timings stored then) and the GeoTIFF (whose INPUTS tag is the SLC's hash) are the same
+    bytes; the timings are still reported (--json) and stored when SOURCE_DATE_EPOCH is unset."""
+    import h5py
+
+    from tests.conftest import run_cli
+
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    runs = []
+    for _ in range(2):  # the same command (the command line and the paths are part of the provenance)
+        r = run_cli("focus", small.raw, "-o", tmp_path / "slc.h5", "--range-window", "rect", "--looks-az",
+                    "2", "--geotiff", tmp_path / "amp.tif", "--json")
+        assert r.exit_code == 0, r.stderr
+        assert json.loads(r.stdout)["timings_s"]["total_s"] > 0
+        runs.append({name: (tmp_path / name).read_bytes() for name in ("slc.h5", "amp.tif")})
+        for name in runs[-1]:
+            (tmp_path / name).unlink()
+    for name in runs[0]:
+        assert runs[0][name] == runs[1][name], name
+    with h5py.File(small.slc) as f:  # focused without SOURCE_DATE_EPOCH: the focuser's timings are kept
+        assert len(f["timings"].attrs) > 0 and all(v > 0 for v in f["timings"].attrs.values())
