@@ -207,7 +207,7 @@ def test_quality_cli_with_corner_reflectors_and_on_an_rslc(cli, sim_rslc, sim_re
     recs = json.loads(r.stdout)
     assert [tuple(x) for x in recs] == [RECORD_KEYS] * 3
     assert recs == json.loads(json.dumps(run(Config(sim_rslc, sim_reflectors_csv)).records()))
-    plots = tmp_path / "plots"  # created by the command (issue 29: it failed until the folder existed)
+    plots = tmp_path / "plots"  # created by the command
     r = cli("quality", sim_rslc, "--corner-reflectors", sim_reflectors_csv, "--plots", plots)
     assert r.exit_code == 0 and sorted(p.name for p in plots.iterdir()) == ["cr_T0.png", "cr_T1.png", "cr_T2.png"]
     r = cli("quality", sim_rslc, "--plots", plots)
