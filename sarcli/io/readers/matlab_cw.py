@@ -1,7 +1,9 @@
 """Reader plug-in ``matlab-cw``: a Cumming & Wong MATLAB raw block and its run-parameter file.
 
 Decoding is in :mod:`sarcli.io.matlab`; this adapts it to the reader interface (:mod:`sarcli.io.readers`).
-Sources: ``DATA.mat PARAMS.mat`` (or ``--matlab DATA.mat --params PARAMS.mat`` on the command line);
+Sources: ``DATA.mat PARAMS.mat`` (or ``--matlab DATA.mat --params PARAMS.mat`` on the command line), or a
+folder holding exactly these two MAT files (the run-parameter file is the one with ``f0``, ``Fr``, ``Kr``,
+``Tr``, ``PRF``, ``R0``, ``c``: a block is one scene of ``sarcli batch``);
 the pass's AGC table is an option (``agc``, ``--agc TABLE.mat``), and so is an orbit (``orbit``,
 ``--orbit FILE``: state vectors as CSV or an ESA orbit file, :mod:`sarcli.io.orbit_file`; with the time of
 line 1 of the pass, ``epoch``, since a block carries no time of day).
@@ -39,6 +41,22 @@ class MatlabOptions:
 def _is_mat(path: Path) -> bool:
     with open(path, "rb") as f:
         return f.read(10).startswith(b"MATLAB 5.0")
+
+
+def _pair(folder: Path) -> tuple[Path, Path] | None:
+    """(block, run parameters) of a folder holding exactly two MAT files, one of them a run-parameter
+    file; None otherwise."""
+    import scipy.io
+
+    from sarcli.io.matlab import REQUIRED_PARAMS
+
+    mats = sorted(p for p in folder.iterdir() if p.is_file() and not p.name.startswith("."))
+    if len(mats) != 2 or not all(_is_mat(p) for p in mats):
+        return None
+    is_params = [set(REQUIRED_PARAMS) <= {name for name, _, _ in scipy.io.whosmat(p)} for p in mats]
+    if is_params.count(True) != 1:
+        return None
+    return (mats[1], mats[0]) if is_params[0] else (mats[0], mats[1])
 
 
 def _notes(attrs: dict, n_lines: int) -> list[str]:
@@ -80,11 +98,19 @@ class MatlabCwReader:
     Options = MatlabOptions
 
     def sniff(self, sources: Sequence[Path]) -> bool:
+        if len(sources) == 1 and Path(sources[0]).is_dir():
+            return _pair(Path(sources[0])) is not None
         return len(sources) == 2 and all(Path(s).is_file() and _is_mat(Path(s)) for s in sources)
 
     def read(self, sources: Sequence[Path], options: MatlabOptions) -> Ingested:
         from sarcli.io.matlab import read_matlab_block
 
+        if len(sources) == 1 and Path(sources[0]).is_dir():
+            pair = _pair(Path(sources[0]))
+            if pair is None:
+                raise ConfigError(f"{sources[0]}: a MATLAB block folder holds two MAT files, the block and its run "
+                                  "parameters (f0, Fr, Kr, Tr, PRF, R0, c)")
+            sources = pair
         if len(sources) != 2:
             raise ConfigError("a MATLAB block needs two files: DATA.mat PARAMS.mat")
         data, params = (Path(s) for s in sources)
