@@ -147,7 +147,7 @@ class FocusReport(Report):
 
     def lines(self) -> list[str]:
         du = self.doppler_used
-        out = [f"focused {Path(self.input).name} -> {self.products['slc']} ({self.shape[0]} x {self.shape[1]}, "
+        out = [f"focused {self.input} -> {self.products['slc']} ({self.shape[0]} x {self.shape[1]}, "
                f"{self.algorithm}) in {self.timings_s['total_s']:.2f} s; Doppler {self.doppler_source}; used at the "
                f"closest range {du['range_m_mid']:.0f} m, mid-swath (the model read at its beam-centre range R0 / "
                f"cos(squint), median over the blocks): fdc {du['fdc_hz_mid']:.1f} Hz, "
@@ -167,7 +167,7 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
     if config.doppler is not None:
         from sarcli.io.doppler_product import read_doppler
 
-        return read_doppler(config.doppler), f"read from {Path(config.doppler).name}"
+        return read_doppler(config.doppler), f"read from {config.doppler}"
     if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT
         from sarcli.model.doppler import GeometricDoppler

@@ -98,3 +98,27 @@ def test_a_usage_mistake_is_one_line_with_exit_2(cli, args):
     assert r.exit_code == 2 and len(lines) == 1, r.stderr
     assert lines[0].startswith("sarcli: error: ") and "-h" in lines[0], lines[0]
     assert "Usage:" not in r.stderr and "Try '" not in r.stderr
+
+
+def test_every_command_says_what_it_wrote(cli, small, tmp_path):
+    """Each file a command writes is named in its status ("wrote PATH"), with the folder as given."""
+    from pathlib import Path
+
+    samples = Path(__file__).parents[2] / "samples"
+    d = tmp_path / "out"
+    d.mkdir()
+    runs = [
+        (("gbsar", "simulate", samples / "gbsar_p1.toml", "-o", d / "p1.h5"), [d / "p1.h5"]),
+        (("gbsar", "simulate", samples / "gbsar_p2.toml", "-o", d / "p2.h5"), [d / "p2.h5"]),
+        (("gbsar", "focus", d / "p1.h5", "-o", d / "i.h5", "--quicklook", d / "i.png"), [d / "i.h5", d / "i.png"]),
+        (("gbsar", "coherence", d / "p1.h5", d / "p2.h5", "-o", d / "ps.h5", "--csv", d / "ps.csv", "--plot",
+          d / "ps.png"), [d / "ps.h5", d / "ps.csv", d / "ps.png"]),
+        (("quality", small.slc, "--plot", d / "irf.png"), [d / "irf.png"]),
+    ]
+    for args, written in runs:
+        r = cli(*args)
+        assert r.exit_code == 0, r.stderr
+        for p in written:
+            assert p.is_file() and f"wrote {p}" in r.stdout + r.stderr, (args[:2], p)
+    r = cli("focus", small.raw, "-o", d / "slc.h5", "--fdc", "-6558", "--fr", "-1781")
+    assert f"focused {small.raw} -> {d / 'slc.h5'}" in r.stderr  # the input's folder kept
