@@ -374,8 +374,10 @@ def write_quicklook(
     ylabel: str = "",
     colorbar_label: str = "",
     aspect: str | float = "auto",
+    decorate: Callable[[Any], None] | None = None,
 ) -> None:
-    """A PNG for people: amplitude in dB (or the values as given, e.g. phase with a cyclic cmap)."""
+    """A PNG for people: amplitude in dB (or the values as given, e.g. phase with a cyclic cmap).
+    ``decorate(ax)``: the caller's additions to the axes (tick formats, marks) before the layout."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -400,6 +402,8 @@ def write_quicklook(
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     fig.colorbar(im, ax=ax, label=colorbar_label)
+    if decorate is not None:
+        decorate(ax)
     fig.tight_layout()
     with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")

@@ -64,5 +64,51 @@ def test_quality_plot_and_time_axis_note(cli, small, tmp_path):
     lead = float(np.mean(tg["beam_center_time_s"] - tg["zero_doppler_time_s"]))  # the simulator's own times
     label = time_axis_label(slc)
     shown = float(label.split("this ")[1].split(" s")[0])
-    assert label.startswith("zero-Doppler time (s)") and shown == pytest.approx(lead, abs=0.05)
+    assert label.startswith("zero-Doppler time (UTC, ") and shown == pytest.approx(lead, abs=0.05)
     assert lead > 3.0  # RADARSAT-1's squint: the -3.7 s of the issue
+
+
+def _drawn(monkeypatch, draw):
+    """The matplotlib figure ``draw()`` saves (captured at savefig, drawn so its tick labels exist)."""
+    from matplotlib.figure import Figure
+
+    figs = []
+    real = Figure.savefig
+
+    def keep(self, *a, **k):
+        self.canvas.draw()
+        figs.append(self)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    draw()
+    return figs[-1]
+
+
+def test_quicklook_time_axis_in_utc_and_partly_focused_lines_marked(small, tmp_path, monkeypatch):
+    """The time axis reads UTC clock times (no '+9.268e3' offset), labelled with the date; the lines
+    without their whole aperture are shaded and named in the legend; an SLC without a fully focused line
+    says so in the title."""
+    import dataclasses
+    import datetime as dt
+
+    from sarcli.focus.quicklook import write_slc_quicklook
+    from sarcli.io.slc import read_slc
+
+    slc = read_slc(small.slc)
+    fig = _drawn(monkeypatch, lambda: write_slc_quicklook(tmp_path / "q.png", slc, 2, 1))
+    ax = fig.axes[0]
+    epoch = dt.datetime.fromisoformat(slc.epoch_utc.replace("Z", "+00:00"))
+    labels = [t.get_text() for t in ax.get_yticklabels() if t.get_text()]
+    assert labels and ax.yaxis.get_offset_text().get_text() == ""
+    for t, text in zip(ax.get_yticks(), [t.get_text() for t in ax.get_yticklabels()], strict=True):
+        if text:
+            assert text == (epoch + dt.timedelta(seconds=float(t))).strftime("%H:%M:%S.%f")[:11]
+    assert "UTC" in ax.get_ylabel() and epoch.strftime("%Y-%m-%d") in ax.get_ylabel()
+    n = slc.azimuth_time.size
+    partly = slc.first_full_line > 0 or slc.last_full_line < n - 1
+    legend = ax.get_legend()
+    assert partly and legend is not None and "partly focused" in legend.get_texts()[0].get_text()
+    none = dataclasses.replace(slc, first_full_line=n, last_full_line=-1)
+    fig = _drawn(monkeypatch, lambda: write_slc_quicklook(tmp_path / "none.png", none, 2, 1))
+    assert "no fully focused line" in fig.axes[0].get_title()
