@@ -118,7 +118,8 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
                     acquisition: tuple[str, float, float] | None = None, **extra: Any) -> dict[str, str]:
     """The GeoTIFF metadata of an image: who made it and from what (``SOFTWARE``, ``SOFTWARE_VERSION``,
     ``CREATED_UTC`` (``SOURCE_DATE_EPOCH`` when set), ``COMMAND_LINE`` (the caller's, as products
-    record it), ``INPUTS`` (JSON list of ``{path, sha256}``)), what was observed (``SENSOR``,
+    record it), ``INPUTS`` (JSON list of ``{path, sha256}``, the path as the caller gave it, folder
+    included)), what was observed (``SENSOR``,
     ``WAVELENGTH_M``, ``LOOK_SIDE``, ``ACQUISITION_START_UTC``/``_STOP_UTC`` from ``acquisition`` =
     (epoch, first s, last s)), the TIFF's own ``TIFFTAG_SOFTWARE``/``TIFFTAG_DATETIME``, and ``extra``
     (upper-cased keys; dicts and lists as JSON)."""
@@ -129,7 +130,8 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
     created = created_utc()
     tags: dict[str, Any] = {
         "SOFTWARE": "sarcli", "SOFTWARE_VERSION": __version__, "CREATED_UTC": created,
-        "COMMAND_LINE": current().command_line, "INPUTS": json.dumps(describe_inputs(inputs)),
+        "COMMAND_LINE": current().command_line, "INPUTS": json.dumps(
+            [{**d, "path": os.fspath(p)} for d, p in zip(describe_inputs(inputs), inputs, strict=True)]),
         "TIFFTAG_SOFTWARE": f"sarcli {__version__}", "TIFFTAG_DATETIME": _tiff_datetime(created),
     }
     if sensor is not None:
