@@ -82,7 +82,7 @@ def _usage_fail(e: Any) -> typer.Exit:
     command and its help, exit 2, instead of Click's usage text."""
     where = e.ctx.command_path if e.ctx is not None else "sarcli"
     text = " ".join(e.format_message().split())
-    return fail(f"{where}: {text} (options: '{where} -h')", EXIT_USAGE)
+    return fail(f"{where}: {text} (see '{where} -h')", EXIT_USAGE)
 
 
 class SarcliGroup(TyperGroup):
