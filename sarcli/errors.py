@@ -2,8 +2,8 @@
 
 Every class is a :class:`ValueError`, so a library caller can ``except ValueError``. The exit codes
 belong to the command line only (``sarcli.cli.common.exit_code_for``): 2 for a usage or
-configuration mistake, 1 for bad data (a malformed product or file), 3 for an instrument fault,
-130 for an interruption.
+configuration mistake (a missing input file included), 1 for bad data (a malformed product or
+file), 3 for an instrument fault, 130 for an interruption.
 """
 
 
@@ -20,6 +20,11 @@ class ConfigError(SarcliError):
 
 class ProductError(SarcliError):
     """A product or input file is missing, malformed, physically implausible or of the wrong type."""
+
+
+class MissingFileError(ProductError):
+    """An input file or folder that does not exist: a usage mistake (exit 2), though found where the data
+    are read."""
 
 
 class FormatError(ProductError):

@@ -111,8 +111,8 @@ def plot_point_targets(path: str | os.PathLike, image: np.ndarray, targets: list
     for k, m in enumerate(targets):
         _, _, im = draw_irf(axes[k], image, m["row"], m["col"], range_spacing_m, along_track_spacing_m,
                             (m["irw_range_m"], m["irw_azimuth_m"]))
-        err = f", position error {m['position_error_m']:.2f} m" if "position_error_m" in m else ""
-        axes[k, 2].set_title(f"target {k}: PSLR {m['pslr_range_db']:.1f} / {m['pslr_azimuth_db']:.1f} dB, ISLR "
+        err = f"\nposition error {m['position_error_m']:.2f} m" if "position_error_m" in m else ""
+        axes[k, 2].set_title(f"target {k}: PSLR {m['pslr_range_db']:.1f} / {m['pslr_azimuth_db']:.1f} dB,\nISLR "
                              f"{m['islr_range_db']:.1f} / {m['islr_azimuth_db']:.1f} dB (rg / az){err}", fontsize=9)
         fig.colorbar(im, ax=axes[k, 2], label="dB")
     fig.suptitle(title or "point-target impulse responses")

@@ -1,6 +1,7 @@
 """Corner-reflector CSV files and the reflector's position at the acquisition time.
 
-Two formats (the columns are positional; a header row and ``#`` comment lines are skipped):
+Two formats (the columns are positional; header rows before the first reflector (rows whose numeric
+columns hold no number) and ``#`` comment lines are skipped):
 
 - NISAR (Corner Reflector Software Interface Specification, JPL D-107698 [NISAR-CR-SIS]; 12 columns):
   ``ID, latitude (deg), longitude (deg), height above the WGS-84 ellipsoid (m), azimuth (deg), tilt /
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sarcli.errors import FormatError, ProductError
+from sarcli.errors import FormatError, MissingFileError
 
 NISAR_COLUMNS = ("id", "latitude_deg", "longitude_deg", "height_m", "azimuth_deg", "tilt_deg", "side_length_m",
                  "survey_utc", "validity", "velocity_east_mps", "velocity_north_mps", "velocity_up_mps")
@@ -64,7 +65,17 @@ def _number(text: str, what: str, where: str) -> float:
 
 
 def _is_header(row: list[str]) -> bool:
-    return bool(row) and row[0].strip().strip('"').lower().startswith("corner reflector id")
+    """A header row: none of the six numeric columns after the ID (latitude ... side length) is a number
+    (``ID,lat,lon,...``, ``"Corner reflector ID","Latitude (deg)",...``, a row of units)."""
+
+    def number(text: str) -> bool:
+        try:
+            float(text)
+        except ValueError:
+            return False
+        return True
+
+    return not any(number(x) for x in row[1:7])
 
 
 def parse_reflectors(path: str | os.PathLike) -> list[CornerReflector]:
@@ -73,15 +84,15 @@ def parse_reflectors(path: str | os.PathLike) -> list[CornerReflector]:
 
     path = Path(path)
     if not path.is_file():
-        raise ProductError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise FormatError(f"{path}: not a text (UTF-8) CSV file") from None
     out: list[CornerReflector] = []
     for k, row in enumerate(csv.reader(io.StringIO(text)), start=1):
-        if not row or not "".join(row).strip() or row[0].lstrip().startswith("#") or _is_header(row):
-            continue
+        if not row or not "".join(row).strip() or row[0].lstrip().startswith("#") or (not out and _is_header(row)):
+            continue  # blank, comment, or a header row before the first reflector
         where = f"{path} line {k}"
         if len(row) not in (len(NISAR_COLUMNS), len(UAVSAR_COLUMNS)):
             raise FormatError(f"{where}: {len(row)} columns; a NISAR corner-reflector CSV has 12, the UAVSAR one 7")

@@ -90,7 +90,7 @@ app = make_typer(
         "  sarcli info raw.h5 --json\n\n"
         "  sarcli -v --log-file run.log run steps.toml\n\n"
         "Run 'sarcli COMMAND --help' (or -h) for a command's options and examples. Exit status: 0 done, 1 bad "
-        "data, 2 usage or configuration, 3 instrument fault, 130 interrupted (docs/cli.md)."
+        "data, 2 usage, configuration or a missing file, 3 instrument fault, 130 interrupted (docs/cli.md)."
     ),
     add_completion=True,  # --install-completion / --show-completion (bash, zsh, fish, PowerShell)
     context_settings={"help_option_names": ["-h", "--help"]},  # inherited by every command

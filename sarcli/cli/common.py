@@ -29,7 +29,7 @@ import typer
 from typer.core import TyperGroup
 
 from orbit.errors import OrbitError
-from sarcli.errors import ConfigError, InstrumentError, Interrupted, ProductError, SarcliError
+from sarcli.errors import ConfigError, InstrumentError, Interrupted, MissingFileError, ProductError, SarcliError
 
 T = TypeVar("T")
 
@@ -51,11 +51,14 @@ EXIT_USAGE, EXIT_DATA, EXIT_INSTRUMENT, EXIT_INTERRUPT = 2, 1, 3, 130
 
 
 def exit_code_for(error: BaseException) -> int:
-    """The exit status of an error: 130 interrupted, 3 instrument, 1 bad data, 2 usage or configuration."""
+    """The exit status of an error: 130 interrupted, 3 instrument, 1 bad data, 2 usage or configuration
+    (a missing input file is a usage mistake: 2)."""
     if isinstance(error, Interrupted | KeyboardInterrupt):
         return EXIT_INTERRUPT
     if isinstance(error, InstrumentError):
         return EXIT_INSTRUMENT
+    if isinstance(error, MissingFileError | FileNotFoundError):
+        return EXIT_USAGE
     if isinstance(error, ProductError | OrbitError | OSError):
         return EXIT_DATA
     return EXIT_USAGE
@@ -68,8 +71,30 @@ def fail(message: str, exit_code: int = EXIT_USAGE) -> typer.Exit:
     return typer.Exit(exit_code)
 
 
+#: Click's UsageError and the no-arguments-shows-help one (Typer 0.28 ships its own Click: found through
+#: Typer's BadParameter, a UsageError)
+_UsageError = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+_NoArgsIsHelp = getattr(sys.modules[_UsageError.__module__], "NoArgsIsHelpError", ())
+
+
+def _usage_fail(e: Any) -> typer.Exit:
+    """Click's own usage error (unknown option or command, missing value, bad choice) as one line naming the
+    command and its help, exit 2, instead of Click's usage text."""
+    where = e.ctx.command_path if e.ctx is not None else "sarcli"
+    text = " ".join(e.format_message().split())
+    return fail(f"{where}: {text} (see '{where} -h')", EXIT_USAGE)
+
+
 class SarcliGroup(TyperGroup):
     """A command group that turns user errors into one line on stderr and a non-zero exit."""
+
+    def make_context(self, info_name: str | None, args: list[str], parent: Any = None, **extra: Any) -> Any:
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _NoArgsIsHelp:
+            raise
+        except _UsageError as e:  # the group's own options (``sarcli --bogus``)
+            raise _usage_fail(e) from None
 
     def invoke(self, ctx: typer.Context) -> Any:
         from sarcli.io.provenance import Provenance, using
@@ -77,6 +102,10 @@ class SarcliGroup(TyperGroup):
         try:
             with using(Provenance(command_line=command_line())):
                 return super().invoke(ctx)
+        except _NoArgsIsHelp:
+            raise
+        except _UsageError as e:  # a command's options, an unknown command
+            raise _usage_fail(e) from None
         except (SarcliError, OrbitError) as e:  # OrbitError: impossible geometry, bad state vectors
             raise fail(str(e), exit_code_for(e)) from None
         except (FileNotFoundError, PermissionError, IsADirectoryError) as e:

@@ -24,6 +24,12 @@ from sarcli.model.constants import C_LIGHT
 from sarcli.model.doppler import PolyDoppler
 
 
+def _drawn(blocks: dict, key: str) -> bool:
+    """Whether the block column ``key`` has a value to draw (a product without an orbit stores NaN: no
+    line, so no legend entry)."""
+    return key in blocks and bool(np.isfinite(np.asarray(blocks[key], np.float64)).any())
+
+
 def truth_curves(raw) -> dict[str, np.ndarray] | None:
     """The simulator's Doppler truth of a raw product on its sample ranges (``range_m``, ``fdc_hz``,
     ``fr_hz_per_s``, ``time_s``), or None for a product without one."""
@@ -69,7 +75,7 @@ def plot_doppler(path: str | os.PathLike, model: PolyDoppler, raw=None, title: s
     ax = axes[0]
     sc = blocks(ax, np.asarray(b["fdc_hz"], np.float64), "blocks (colour: quality)")
     ax.plot(rr * km, model.fdc(rr, s.scene_time_s), "k-", lw=1.5, label=f"fitted model at t = {s.scene_time_s:.3g} s")
-    if "fdc_orbit_hz" in b:
+    if _drawn(b, "fdc_orbit_hz"):
         o = np.argsort(r)
         ax.plot(r[o] * km, np.asarray(b["fdc_orbit_hz"])[o], "--", color="tab:orange", lw=1.2,
                 label="orbit + attitude geometry")
@@ -84,7 +90,7 @@ def plot_doppler(path: str | os.PathLike, model: PolyDoppler, raw=None, title: s
     ax = axes[1]
     res = np.asarray(b["fdc_hz"], np.float64) - model.fdc(r, t)
     blocks(ax, res, "blocks - model")
-    if "fdc_orbit_hz" in b:
+    if _drawn(b, "fdc_orbit_hz"):
         o = np.argsort(r)
         ax.plot(r[o] * km, (np.asarray(b["fdc_orbit_hz"], np.float64) - model.fdc(r, t))[o], "--",
                 color="tab:orange", label="geometry - model")
@@ -103,7 +109,7 @@ def plot_doppler(path: str | os.PathLike, model: PolyDoppler, raw=None, title: s
     ax = axes[2]
     blocks(ax, np.asarray(b["fr_hz_per_s"], np.float64), "blocks")
     ax.plot(rr * km, model.fr(rr, s.scene_time_s), "k-", lw=1.5, label="model")
-    if "fr_seed_hz_per_s" in b:
+    if _drawn(b, "fr_seed_hz_per_s"):
         o = np.argsort(r)
         ax.plot(r[o] * km, np.asarray(b["fr_seed_hz_per_s"])[o], "--", color="tab:orange", label="geometric seed")
     if truth is not None and truth["fr_hz_per_s"] is not None:

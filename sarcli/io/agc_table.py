@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 import scipy.io
 
-from sarcli.errors import FormatError
+from sarcli.errors import FormatError, MissingFileError
 from sarcli.io.linepower import line_power_db
 
 Z_MATCH = 8.0
@@ -62,7 +62,7 @@ def read_agc_table(path: str | os.PathLike, variable: str | None = None) -> np.n
     a missing, unreadable or non-numeric table."""
     path = Path(path)
     if not path.is_file():
-        raise FormatError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     try:
         mat = scipy.io.loadmat(path, squeeze_me=True)
     except NotImplementedError:

@@ -37,7 +37,7 @@ import h5py
 import numpy as np
 
 from sarcli import __version__
-from sarcli.errors import ProductError
+from sarcli.errors import MissingFileError, ProductError
 from sarcli.io.atomic import atomic_path, readable_name
 from sarcli.io.provenance import current
 from sarcli.model import checks as ck
@@ -174,7 +174,8 @@ def to_jsonable(obj: Any) -> Any:
     return obj
 
 
-def _reproducible() -> bool:
+def reproducible() -> bool:
+    """Whether ``SOURCE_DATE_EPOCH`` is set: products then store nothing that depends on the clock."""
     return bool(os.environ.get("SOURCE_DATE_EPOCH", "").strip())
 
 
@@ -500,7 +501,7 @@ def open_product(path: str | os.PathLike, product_type: str | Sequence[str] | No
     """
     path = Path(path)
     if not path.exists():
-        raise ProductError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     if path.is_file():
         probe_metadata(path)
     try:

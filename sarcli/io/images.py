@@ -118,7 +118,8 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
                     acquisition: tuple[str, float, float] | None = None, **extra: Any) -> dict[str, str]:
     """The GeoTIFF metadata of an image: who made it and from what (``SOFTWARE``, ``SOFTWARE_VERSION``,
     ``CREATED_UTC`` (``SOURCE_DATE_EPOCH`` when set), ``COMMAND_LINE`` (the caller's, as products
-    record it), ``INPUTS`` (JSON list of ``{path, sha256}``)), what was observed (``SENSOR``,
+    record it), ``INPUTS`` (JSON list of ``{path, sha256}``, the path as the caller gave it, folder
+    included)), what was observed (``SENSOR``,
     ``WAVELENGTH_M``, ``LOOK_SIDE``, ``ACQUISITION_START_UTC``/``_STOP_UTC`` from ``acquisition`` =
     (epoch, first s, last s)), the TIFF's own ``TIFFTAG_SOFTWARE``/``TIFFTAG_DATETIME``, and ``extra``
     (upper-cased keys; dicts and lists as JSON)."""
@@ -129,7 +130,8 @@ def provenance_tags(inputs: Sequence[str | os.PathLike] = (), *, sensor: str | N
     created = created_utc()
     tags: dict[str, Any] = {
         "SOFTWARE": "sarcli", "SOFTWARE_VERSION": __version__, "CREATED_UTC": created,
-        "COMMAND_LINE": current().command_line, "INPUTS": json.dumps(describe_inputs(inputs)),
+        "COMMAND_LINE": current().command_line, "INPUTS": json.dumps(
+            [{**d, "path": os.fspath(p)} for d, p in zip(describe_inputs(inputs), inputs, strict=True)]),
         "TIFFTAG_SOFTWARE": f"sarcli {__version__}", "TIFFTAG_DATETIME": _tiff_datetime(created),
     }
     if sensor is not None:
@@ -374,8 +376,10 @@ def write_quicklook(
     ylabel: str = "",
     colorbar_label: str = "",
     aspect: str | float = "auto",
+    decorate: Callable[[Any], None] | None = None,
 ) -> None:
-    """A PNG for people: amplitude in dB (or the values as given, e.g. phase with a cyclic cmap)."""
+    """A PNG for people: amplitude in dB (or the values as given, e.g. phase with a cyclic cmap).
+    ``decorate(ax)``: the caller's additions to the axes (tick formats, marks) before the layout."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -400,6 +404,8 @@ def write_quicklook(
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     fig.colorbar(im, ax=ax, label=colorbar_label)
+    if decorate is not None:
+        decorate(ax)
     fig.tight_layout()
     with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, format="png")

@@ -47,7 +47,7 @@ import numpy as np
 import scipy.io
 
 from orbit.timeutil import format_utc, parse_utc
-from sarcli.errors import ConfigError, FormatError
+from sarcli.errors import ConfigError, FormatError, MissingFileError
 from sarcli.io.ceos.radarsat1.samples import is_four_bit
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.raw import Radar, RawProduct
@@ -62,12 +62,12 @@ VANCOUVER_PUBLISHED = {
                        "scene (Vr, Ka magnitude, Doppler centroid 'as given with the data'); published, "
                        "not measured on this block"),
 }
-_REQUIRED = ("f0", "Fr", "Kr", "Tr", "PRF", "R0", "c")
+REQUIRED_PARAMS = ("f0", "Fr", "Kr", "Tr", "PRF", "R0", "c")
 
 
 def _load(path: Path, what: str) -> dict[str, Any]:
     if not path.is_file():
-        raise FormatError(f"{path}: no such file")
+        raise MissingFileError(f"{path}: no such file")
     try:
         return scipy.io.loadmat(path, squeeze_me=True)
     except NotImplementedError:
@@ -176,7 +176,7 @@ def read_matlab_block(data_path: str | os.PathLike, params_path: str | os.PathLi
     if first_line == "auto" and agc_path is None:
         raise ConfigError("first_line=auto finds the start line from the AGC table: give the table (agc, --agc)")
     params = _load(params_path, "parameter")
-    missing = [k for k in _REQUIRED if k not in params]
+    missing = [k for k in REQUIRED_PARAMS if k not in params]
     if missing:
         raise FormatError(f"{params_path}: parameter file lacks {', '.join(missing)} (not a Cumming & Wong "
                           "run-parameter file?)")

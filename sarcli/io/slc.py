@@ -25,7 +25,7 @@ Layout (SI units)::
                            equivalent sigma0, linear); attributes constant (K), applied / not_applied
                            (JSON lists of the model's terms), details (JSON); nes0_per_sample
                            (n_samples,) the noise floor of every column (on /slant_range)
-    /timings               attributes: seconds per processing stage
+    /timings               attributes: seconds per processing stage (absent under SOURCE_DATE_EPOCH)
 
 Times are ``seconds since <epoch_utc>`` (CF); /image's axes are the dimension scales /azimuth_time and
 /slant_range, so ``xarray.open_dataset(path, engine="h5netcdf")`` labels it (docs/products.md).
@@ -55,6 +55,7 @@ from sarcli.io.h5common import (
     open_product,
     read_array,
     read_mapping,
+    reproducible,
     require,
     to_jsonable,
     write_mapping,
@@ -158,9 +159,10 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
         write_mapping(f, "truth", s.truth, s.epoch_utc)
     if s.calibration is not None:
         write_calibration(f, s.calibration, tunits, np.asarray(s.slant_range, np.float64))
-    tg = group(f, "timings")
-    for k, v in sorted(s.timings.items()):
-        tg.attrs[k] = float(v)
+    if not reproducible():  # wall-clock seconds: left out under SOURCE_DATE_EPOCH (byte-identical files)
+        tg = group(f, "timings")
+        for k, v in sorted(s.timings.items()):
+            tg.attrs[k] = float(v)
 
 
 def write_calibration(f: h5py.Group, cal: Calibration, tunits: str, slant_range: np.ndarray | None = None) -> None:

@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from sarcli.errors import ConfigError, FormatError
+from sarcli.errors import ConfigError, FormatError, MissingFileError
 from sarcli.io.scan import POLARIZATIONS
 from sarcli.model.gbsar import Antenna, Scan
 
@@ -578,7 +578,7 @@ def read_sweeps(paths: Sequence[str | Path], names: Names = Names()) -> Sweeps:
         if p.suffix.lower() not in FORMATS:
             raise FormatError(f"{p}: unknown sweep format '{p.suffix}' (use .mat, .npz, .npy, .csv, .s1p or .s2p)")
         if not p.is_file():
-            raise FormatError(f"{p}: no such file")
+            raise MissingFileError(f"{p}: no such file")
         kinds.add(FORMATS[p.suffix.lower()])
     if len(kinds) > 1:
         raise ConfigError(f"the inputs mix formats ({', '.join(sorted(kinds))}): import one format at a time")

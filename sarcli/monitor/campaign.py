@@ -200,7 +200,7 @@ class Campaign:
         self.state.alarms_csv_bytes = self.store.append_alarms([csv_line(e) for e in out.events])
         if rec["status"] == "accepted":
             self._log(f"scan {rec['scan']} ({rec['time_utc']}): {rec['n_points']} points, APS residual "
-                      f"{rec['aps_residual_mm'] if rec['aps_residual_mm'] is not None else '-'} mm, level "
+                      f"{'-' if rec['aps_residual_mm'] is None else format(rec['aps_residual_mm'], '.3f')} mm, level "
                       f"{rec['alarm_level']}")
         else:
             self._log(f"scan {rec['scan']} ({rec['time_utc']}) {rec['status']}: {rec['reason']}", logging.WARNING)

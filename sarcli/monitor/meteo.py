@@ -22,7 +22,7 @@ import math
 import os
 from pathlib import Path
 
-from sarcli.errors import ProductError
+from sarcli.errors import MissingFileError, ProductError
 
 COLUMNS = ("time_utc", "temperature_c", "humidity_percent", "pressure_hpa")
 
@@ -57,7 +57,7 @@ class MeteoFile:
 
     def _refresh(self) -> None:
         if not self.path.exists():
-            raise ProductError(f"{self.path}: meteo file not found")
+            raise MissingFileError(f"{self.path}: meteo file not found")
         if self.path.stat().st_size < self.offset:  # replaced by a shorter file: read it again
             self.offset, self.header, self.times, self.rows, self._tail = 0, None, [], [], ""
         with open(self.path, encoding="utf-8") as fh:

@@ -89,12 +89,14 @@ def _fmt(v: float) -> str:
     return f"{v:.6g}" if abs(v) >= 1e-3 or v == 0 else f"{v:.2e}"
 
 
-def svg_chart(title: str, t: np.ndarray, series: list[tuple[str, np.ndarray]], y_label: str,
+def svg_chart(title: str, t: np.ndarray, series: list[tuple], y_label: str,
               hlines: list[tuple[float, str, str]] = (), width: int = 560, height: int = 230) -> str:
-    """A line chart: ``series`` (label, values over ``t``), horizontal ``hlines`` (value, colour, label)."""
+    """A line chart: ``series`` (label, values over ``t``[, colour]: an object keeps its colour in every
+    chart), horizontal ``hlines`` (value, colour, label). A series without a finite value gets the note
+    "LABEL: no data" instead of a legend entry."""
     ml, mr, mt, mb = 58, 12, 26, 34
     pw, ph = width - ml - mr, height - mt - mb
-    vals = [v[np.isfinite(v)] for _, v in series]
+    vals = [s[1][np.isfinite(s[1])] for s in series]
     ys = np.concatenate(vals + [np.array([h[0] for h in hlines])]) if vals or hlines else np.zeros(0)
     parts = [f'<svg class="chart" viewBox="0 0 {width} {height}" width="{width}" height="{height}" '
              f'role="img" aria-label="{html.escape(title)}">',
@@ -125,15 +127,18 @@ def svg_chart(title: str, t: np.ndarray, series: list[tuple[str, np.ndarray]], y
     for value, colour, label in hlines:
         parts.append(f'<line x1="{ml}" x2="{ml + pw}" y1="{py(value):.1f}" y2="{py(value):.1f}" stroke="{colour}" '
                      f'class="thr"><title>{html.escape(label)} {value:g}</title></line>')
-    for k, (label, v) in enumerate(series):
-        colour = SERIES_COLOURS[k % len(SERIES_COLOURS)]
+    for k, (label, v, *given) in enumerate(series):
+        colour = given[0] if given else SERIES_COLOURS[k % len(SERIES_COLOURS)]
         ok = np.isfinite(v)
         pts = " ".join(f"{px(a):.1f},{py(b):.1f}" for a, b in zip(t[ok], v[ok], strict=True))
         if pts:
             parts.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="1.6">'
-                         f'<title>{html.escape(label)}</title></polyline>')
-        parts.append(f'<text x="{ml + 6 + 110 * k}" y="{mt + 12}" fill="{colour}" class="lg">'
-                     f'{html.escape(label)}</text>')
+                         f'<title>{html.escape(label)}</title></polyline>'
+                         f'<text x="{ml + 6 + 110 * k}" y="{mt + 12}" fill="{colour}" class="lg">'
+                         f'{html.escape(label)}</text>')
+        else:  # a series without a value: a note, not a legend entry for a line that is not there
+            parts.append(f'<text x="{ml + 6 + 110 * k}" y="{mt + 12}" class="lg na">{html.escape(label)}: no data'
+                         f'</text>')
     parts.append("</svg>")
     return "".join(parts)
 
@@ -176,18 +181,39 @@ def _map_svg(uri: str, static: Static, cfg: MonitorConfig, title: str, unit: str
         x, y = px(float(az[c])), py(float(rg[r]))
         parts.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="4" class="wp"><title>{html.escape(wp.name)}</title>'
                      f'</circle><text x="{x + 6:.1f}" y="{y - 5:.1f}" class="wl">{html.escape(wp.name)}</text>')
-    # colour bar
-    bx = ml + pw + 12
-    grad = np.linspace(1, 0, 64)[:, None] * np.ones((1, 6))
-    bar = colour_map(grad * (vmax - vmin) + vmin, np.ones(grad.shape, bool), grad, vmin, vmax, diverging)[::-1]
-    parts.append(f'<image href="{data_uri(bar)}" x="{bx}" y="{mt}" width="12" height="{ph}" '
-                 f'preserveAspectRatio="none"/><text x="{bx + 15}" y="{mt + 9}" class="cb">{vmax:.3g}</text>'
-                 f'<text x="{bx + 15}" y="{mt + ph}" class="cb">{vmin:.3g}</text>'
-                 f'<text x="{bx + 15}" y="{mt + ph / 2 + 14}" class="cb">{html.escape(unit)}</text></svg>')
+    parts.append(_colour_bar(ml + pw + 12, mt, ph, vmin, vmax, diverging, unit) + "</svg>")
     return "".join(parts)
 
 
-def _geocoded(static: Static, values: np.ndarray, show: np.ndarray, background: np.ndarray, vmax: float) -> str:
+def _colour_bar(bx: float, top: float, ph: float, vmin: float, vmax: float, diverging: bool, unit: str) -> str:
+    """A vertical colour bar: its two ends labelled, and the unit in the middle (none for "1": a ratio)."""
+    grad = np.linspace(1, 0, 64)[:, None] * np.ones((1, 6))
+    bar = colour_map(grad * (vmax - vmin) + vmin, np.ones(grad.shape, bool), grad, vmin, vmax, diverging)[::-1]
+    out = (f'<image href="{data_uri(bar)}" x="{bx}" y="{top}" width="12" height="{ph}" '
+           f'preserveAspectRatio="none"/><text x="{bx + 15}" y="{top + 9}" class="cb">{vmax:.3g}</text>'
+           f'<text x="{bx + 15}" y="{top + ph}" class="cb">{vmin:.3g}</text>')
+    if unit != "1":
+        out += f'<text x="{bx + 15}" y="{top + ph / 2 + 4}" class="cb">{html.escape(unit)}</text>'
+    return out
+
+
+def _enu_polygon(area, static: Static) -> np.ndarray:
+    """(k, 2) east/north vertices of an area's polygon (image frame: azimuth, range R0; site frame: x, y on
+    flat ground), each edge densified so that its curvature on the map shows."""
+    from sarcli.gbsar.geocode import slant_to_enu
+
+    poly = np.asarray(area.polygon + (area.polygon[0],), np.float64)
+    f = np.linspace(0.0, 1.0, 16, endpoint=False)
+    dense = np.concatenate([a + f[:, None] * (b - a) for a, b in zip(poly[:-1], poly[1:], strict=True)])
+    x, second = dense[:, 0], dense[:, 1]
+    h = static.rail_height_m
+    r0 = second if area.frame == "image" else np.sqrt(second ** 2 + h ** 2)
+    e, n = slant_to_enu(x, r0, static.site, h, static.rail_centre_m)
+    return np.column_stack([e, n])
+
+
+def _geocoded(static: Static, values: np.ndarray, show: np.ndarray, background: np.ndarray, vmax: float,
+              cfg: MonitorConfig | None = None) -> str:
     """The displacement on a north-up local east/north grid (the site's tangent plane), or '' when the
     site is not georeferenced."""
     from sarcli.gbsar.geocode import resample_to_map
@@ -205,18 +231,38 @@ def _geocoded(static: Static, values: np.ndarray, show: np.ndarray, background: 
     e0, n1 = transform.c, transform.f
     e1, n0 = e0 + w * transform.a, n1 + h * transform.e
     width = 420
-    pw = width - 60
+    pw = width - 60 - 50
     ph = int(min(max(pw * (n1 - n0) / (e1 - e0), 120), 520))
+
+    def px(x: float) -> float:
+        return 46 + (x - e0) / (e1 - e0) * pw
+
+    def py(y: float) -> float:
+        return 22 + (1 - (y - n0) / (n1 - n0)) * ph
+
+    areas = ""
+    for area in (cfg.areas if cfg is not None else ()):
+        if area.polygon is not None:
+            pts = " ".join(f"{px(x):.1f},{py(y):.1f}" for x, y in _enu_polygon(area, static) if np.isfinite(x + y))
+            areas += (f'<polygon points="{pts}" class="{"stablearea" if area.stable else "area"}">'
+                      f'<title>{html.escape(area.name)}</title></polygon>')
+    north = (f'<g class="north"><line x1="{46 + pw - 14}" y1="{22 + 34}" x2="{46 + pw - 14}" y2="{22 + 12}" '
+             f'stroke="#000" stroke-width="2" marker-end="url(#arrow)"/><text x="{46 + pw - 14}" y="{22 + 46}" '
+             f'class="xt">N</text></g><defs><marker id="arrow" viewBox="0 0 10 10" refX="5" refY="5" '
+             f'markerWidth="5" markerHeight="5" orient="auto"><path d="M0,0 L10,5 L0,10 z"/></marker></defs>')
     ticks_e = "".join(f'<text x="{46 + (x - e0) / (e1 - e0) * pw:.1f}" y="{22 + ph + 13}" class="xt">{_fmt(x)}</text>'
                       for x in _nice_ticks(e0, e1, 4))
     ticks_n = "".join(f'<text x="42" y="{22 + (1 - (y - n0) / (n1 - n0)) * ph + 4:.1f}" class="yt">{_fmt(y)}</text>'
                       for y in _nice_ticks(n0, n1, 5))
     return (f'<svg class="map" viewBox="0 0 {width} {ph + 52}" width="{width}" height="{ph + 52}" role="img" '
-            f'aria-label="geocoded displacement"><text x="46" y="14" class="ct">displacement, east/north (m) about '
+            f'aria-label="geocoded displacement"><text x="46" y="14" class="ct">LOS displacement (mm), east/north '
+            f'about '
             f'{site.latitude_deg:.4f}, {site.longitude_deg:.4f}</text>'
             f'<image href="{data_uri(rgba)}" x="46" y="22" width="{pw}" height="{ph}" preserveAspectRatio="none"/>'
-            f'<rect x="46" y="22" width="{pw}" height="{ph}" class="frame"/>{ticks_e}{ticks_n}'
-            f'<text x="{46 + pw / 2}" y="{ph + 49}" class="xl">east (m)</text></svg>')
+            f'<rect x="46" y="22" width="{pw}" height="{ph}" class="frame"/>{ticks_e}{ticks_n}{areas}{north}'
+            f'<text x="{46 + pw / 2}" y="{ph + 49}" class="xl">east (m)</text>'
+            f'<text x="10" y="{22 + ph / 2}" class="yl" transform="rotate(-90 10 {22 + ph / 2})">north (m)</text>'
+            f'{_colour_bar(46 + pw + 12, 22, ph, -vmax, vmax, True, "mm")}</svg>')
 
 
 CSS = """
@@ -260,7 +306,18 @@ window.addEventListener('error', function(e){
 def _cell(v: Any, digits: int = 3) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "&ndash;"
-    return f"{v:.{digits}f}" if isinstance(v, float) else html.escape(str(v))
+    return f"{round(v, digits) + 0.0:.{digits}f}" if isinstance(v, float) else html.escape(str(v))  # no -0.000
+
+
+def forecast_cell(forecast: dict | None) -> str:
+    """The failure forecast of the area table: its time and how far ahead ("in 2.2 h") or, once past,
+    how long ago ("0.1 h ago")."""
+    if not forecast:
+        return "&ndash;"
+    h = forecast.get("time_to_failure_h")
+    when = ("" if h is None or not math.isfinite(h) else
+            f" (in {_cell(float(h), 1)} h)" if h >= 0 else f" ({_cell(float(-h), 1)} h ago)")
+    return html.escape(str(forecast["failure_utc"])) + when
 
 
 def render(cfg: MonitorConfig, static: Static, state: State, title: str, updated_utc: str) -> str:
@@ -287,22 +344,25 @@ def render(cfg: MonitorConfig, static: Static, state: State, title: str, updated
                      f"velocity over the last {cfg.velocity.window_scans} scans", "mm/h", -vmax, vmax, True),
             _map_svg(data_uri(colour_map(state.coherence, static.support, background, 0.0, 1.0, False)), static, cfg,
                      "coherence with the previous scan", "1", 0.0, 1.0, False)]
-    geo = _geocoded(static, state.displacement, shown, background, dmax)
+    geo = _geocoded(static, state.displacement, shown, background, dmax, cfg)
     if geo:
         maps.append(geo)
     ch = state.chart
     charts = []
+    names = [w.name for w in cfg.watch] + [a.name for a in cfg.areas]
+    colour = {n: SERIES_COLOURS[k % len(SERIES_COLOURS)] for k, n in enumerate(names)}  # one per object
     if cfg.watch:
         charts.append(svg_chart("displacement at the watch points", ch.t,
-                                [(w.name, ch.series(f"d:{w.name}")) for w in cfg.watch], "LOS displacement (mm)"))
+                                [(w.name, ch.series(f"d:{w.name}"), colour[w.name]) for w in cfg.watch],
+                                "LOS displacement (mm)"))
     for a in cfg.areas:
         thr = [(s * t, LEVEL_COLOURS[LEVELS[i + 1]], LEVELS[i + 1]) for i, t in enumerate(a.velocity_mm_per_h or ())
                for s in (1, -1)]
         charts.append(svg_chart(f"area {a.name}: velocity (median of its points)", ch.t,
-                                [("velocity", ch.series(f"v:{a.name}"))], "mm/h", thr))
+                                [(a.name, ch.series(f"v:{a.name}"), colour[a.name])], "mm/h", thr))
     if cfg.areas:
         charts.append(svg_chart("area displacement (median of its points)", ch.t,
-                                [(a.name, ch.series(f"d:{a.name}")) for a in cfg.areas], "mm"))
+                                [(a.name, ch.series(f"d:{a.name}"), colour[a.name]) for a in cfg.areas], "mm"))
     charts.append(svg_chart("stable points: RMS displacement", ch.t,
                             [("after APS", ch.series("aps_residual_mm")),
                              ("without APS", ch.series("raw_stable_rms_mm"))], "mm"))
@@ -316,7 +376,7 @@ def render(cfg: MonitorConfig, static: Static, state: State, title: str, updated
         f"<tr><td>{html.escape(name)}</td><td><span class='badge' style='background:{LEVEL_COLOURS[a['level']]}'>"
         f"{a['level']}</span></td><td>{a.get('n_points', 0)}</td><td>{_cell(a.get('displacement_mm'))}</td>"
         f"<td>{_cell(a.get('velocity_mm_per_h'))}</td><td>{_cell(a.get('acceleration_mm_per_h2'))}</td>"
-        f"<td>{html.escape(a['forecast']['failure_utc']) + ' (in ' + _cell(a['forecast']['time_to_failure_h'], 1) + ' h)' if a.get('forecast') else '&ndash;'}</td></tr>"  # noqa: E501
+        f"<td>{forecast_cell(a.get('forecast'))}</td></tr>"
         for name, a in last.get("areas", {}).items())
     watch_rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{_cell(v)}</td>"
                          f"<td>{_cell(last.get('velocity_mm_per_h', {}).get(k))}</td></tr>"

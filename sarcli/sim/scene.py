@@ -457,6 +457,6 @@ def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene file; every problem is one :class:`ConfigError` line."""
     p = Path(path)
     if not p.is_file():
-        raise ConfigError(f"{p}: scene file not found")
+        raise ConfigError(f"{p}: no such file")
     doc = load_toml(p)
     return scene_from_mapping(doc, str(p), p.read_text(encoding="utf-8"))

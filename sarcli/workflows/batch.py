@@ -2,9 +2,11 @@
 
 Every entry of ``input`` is a scene: a raw product (``NAME.h5``, product type ``raw``) or anything a
 sensor reader recognises by sniffing (:mod:`sarcli.io.readers`: a CEOS scene folder ``NAME/``, a
-MATLAB block, a NISAR L0B file, ...), ingested first. Other entries (hidden files, other sarcli
-products, files no reader recognises) are listed as ignored; an entry a reader recognises as its
-format but cannot read, or a name used twice, is a failed input. Per scene, in ``output``::
+folder ``NAME/`` holding a MATLAB block and its run parameters, a NISAR L0B file, ...), ingested first.
+Other entries (hidden files, other sarcli products, files no reader recognises) are listed as ignored;
+an entry a reader recognises as its format but cannot read, or a name used twice, is a failed input.
+``geotiff`` (``auto``): a scene without an Earth orbit gets no GeoTIFF (a warning). Per scene, in
+``output``::
 
     NAME.raw.h5       sarcli ingest SOURCE -o NAME.raw.h5                (sensor inputs only)
     NAME.doppler.h5   sarcli doppler RAW -o NAME.doppler.h5
@@ -31,7 +33,7 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from sarcli.config import from_mapping
 from sarcli.errors import ConfigError, ProductError, SarcliError
@@ -52,7 +54,9 @@ class Config:
     workers / threads_per_worker / scheduler: where the tasks run (module docstring; ``workers = 0``:
     here, serially); report: Dask performance report HTML; retries: reruns of a task that failed
     unexpectedly; focus: further ``sarcli.workflows.focus.Config`` fields for every scene (``looks_az``,
-    ``options = {block_lines = 2048}``, ``height_m``, ...)."""
+    ``options = {block_lines = 2048}``, ``height_m``, ...); geotiff: ``auto`` a GeoTIFF for every scene
+    with an Earth orbit (a scene without one is focused without it, with a warning), ``always`` (a scene
+    without an orbit fails), ``never``."""
 
     input: Path
     output: Path
@@ -62,6 +66,7 @@ class Config:
     report: Path | None = None
     retries: int = 1
     focus: dict[str, Any] = field(default_factory=dict)
+    geotiff: Literal["auto", "always", "never"] = "auto"
 
     def __post_init__(self) -> None:
         if self.retries < 0:
@@ -73,6 +78,9 @@ class Config:
                 raise ConfigError("--report is Dask's performance report: it needs a cluster (not --workers 0)")
         else:
             self.cluster()
+        if "geotiff" in self.focus:
+            raise ConfigError("the batch's GeoTIFFs are chosen with --geotiff auto|always|never (option geotiff), "
+                              "not --focus geotiff=...")
         own = sorted(set(self.focus) & set(_FOCUS_OWN))
         if own:
             raise ConfigError(f"focus options {', '.join(own)} are set by the batch for every scene")
@@ -188,6 +196,9 @@ def discover(folder: Path) -> tuple[list[Scene], list[dict[str, str]], list[dict
                 if entry.suffix.lower() in (".h5", ".hdf5"):
                     bad.append({"scene": name, "step": "input", "error": f"{entry}: neither a sarcli raw product nor "
                                 "a file a sensor reader recognises"})
+                elif entry.suffix.lower() == ".mat":
+                    ignored.append({"entry": entry.name, "why": "a MATLAB file alone: put a block with its run "
+                                    "parameters in a folder of its own, one scene"})
                 else:
                     ignored.append({"entry": entry.name, "why": "no sensor reader recognises it"})
             else:
@@ -216,6 +227,25 @@ def run_step(step: str, config: Any, command_line: str, *upstream: Any) -> dict[
     return report.to_dict()
 
 
+def run_focus(config: Any, command_line: str, geotiff: str, *upstream: Any) -> dict[str, Any]:
+    """The focus task: with ``geotiff`` ``auto``, a raw product without an Earth orbit is focused without
+    its GeoTIFF (a warning says so; the command line then has no ``--geotiff``)."""
+    import dataclasses
+    import warnings
+
+    if geotiff == "auto" and config.geotiff is not None:
+        from sarcli.io.raw import read_raw
+
+        orbit = read_raw(config.raw, load_echo=False).orbit
+        if orbit is None or orbit.frame == "LOCAL":
+            warnings.warn(f"{config.raw}: no GeoTIFF: the scene has no Earth orbit "
+                          f"({'no state vectors' if orbit is None else 'a LOCAL frame'}); SLC and quicklook only",
+                          stacklevel=1)
+            command_line = command_line.replace(f" --geotiff {config.geotiff}", "")
+            config = dataclasses.replace(config, geotiff=None)
+    return run_step("focus", config, command_line, *upstream)
+
+
 def _newest(paths: list[Path]) -> float:
     """Latest modification time of the files (a folder: of everything inside it)."""
     times = []
@@ -241,7 +271,7 @@ class _Plan:
     up_to_date: list[str]
 
 
-def plan_scene(scene: Scene, out: Path, suffix: str, focus_extra: dict[str, Any]) -> _Plan:
+def plan_scene(scene: Scene, out: Path, suffix: str, focus_extra: dict[str, Any], geotiff: str = "auto") -> _Plan:
     """What must run for ``scene`` (make's rule, step by step; a step after a rebuilt one is rebuilt)."""
     from sarcli.workflows import doppler, focus, ingest
 
@@ -256,11 +286,13 @@ def plan_scene(scene: Scene, out: Path, suffix: str, focus_extra: dict[str, Any]
                       f"sarcli ingest {scene.source} -o {o['raw']}"))
     chain.append(("doppler", [o["raw"]], [o["doppler"]], doppler.Config(raw=o["raw"], output=o["doppler"]),
                   f"sarcli doppler {o['raw']} -o {o['doppler']}"))
+    tif = None if geotiff == "never" else o["geotiff"]
     fc = from_mapping(focus.Config, {**focus_extra, "raw": o["raw"], "output": o["slc"], "doppler": o["doppler"],
-                                     "geotiff": o["geotiff"], "quicklook": o["quicklook"]}, "batch focus")
-    chain.append(("focus", [o["raw"], o["doppler"]], [o["slc"], o["geotiff"], o["quicklook"]], fc,
-                  f"sarcli focus {o['raw']} --doppler {o['doppler']} -o {o['slc']} --geotiff {o['geotiff']} "
-                  f"--quicklook {o['quicklook']}"))
+                                     "geotiff": tif, "quicklook": o["quicklook"]}, "batch focus")
+    chain.append(("focus", [o["raw"], o["doppler"]], [o["slc"], o["quicklook"]] + ([] if geotiff != "always" else
+                                                                                   [o["geotiff"]]), fc,
+                  f"sarcli focus {o['raw']} --doppler {o['doppler']} -o {o['slc']}"
+                  + ("" if tif is None else f" --geotiff {tif}") + f" --quicklook {o['quicklook']}"))
     steps: dict[str, tuple[Any, str]] = {}
     fresh: list[str] = []
     for step, ins, outs, config, cmd in chain:
@@ -306,16 +338,21 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
             _check_report(config.report)
         scenes, ignored, bad = discover(src)
         if not scenes and not bad:
-            raise ConfigError(f"no raw products or sensor inputs in {config.input}")
+            listed = "; ".join(f"{i['entry']} ({i['why']})" for i in ignored[:8])
+            listed += "; ..." if len(ignored) > 8 else ""
+            raise ConfigError(f"no raw products or sensor inputs in {config.input}"
+                              + (f"; ignored: {listed}" if ignored else " (it is empty)"))
         out.mkdir(exist_ok=True)
         suffix = f" (sarcli batch {config.input} -o {config.output})"
-        plans = [plan_scene(s, out, suffix, dict(config.focus)) for s in scenes]
+        plans = [plan_scene(s, out, suffix, dict(config.focus), config.geotiff) for s in scenes]
         tasks: list[Task] = []
         for p in plans:
             prev: tuple[str, ...] = ()
             for step, (step_config, cmd) in p.steps.items():
                 key = f"{p.scene.name}:{step}"
-                tasks.append(Task(key, run_step, (step, step_config, cmd), prev, label=step))
+                fn, args = ((run_focus, (step_config, cmd, config.geotiff)) if step == "focus" else
+                            (run_step, (step, step_config, cmd)))
+                tasks.append(Task(key, fn, args, prev, label=step))
                 prev = (key,)
         spec = config.cluster()
         where = "this process" if spec is None else spec.describe()

@@ -5,7 +5,7 @@ and a corner-reflector CSV (NISAR or UAVSAR format, ``sarcli.calibration.reflect
 reflector in service and inside the image: measured minus predicted position (range, along track, in
 metres), IRW, PSLR, ISLR in range and azimuth, the theoretical IRWs of the product's bands and windows,
 and the corrections to add before reading an offset as a geometry error (``sarcli.calibration``).
-Optional: one IRF picture per reflector (``plots``: a folder, ``cr_<id>.png``).
+Optional: one IRF picture per reflector (``plots``: a folder, created if missing, ``cr_<id>.png``).
 
 ``Report.records()`` is the machine-readable form of ``--json``: one object per reflector with exactly
 the keys of ``sarcli.calibration.analysis.RECORD_KEYS``; ``Report.to_dict()`` holds everything.
@@ -115,8 +115,8 @@ def run(config: Config, provenance: Provenance | None = None,
     from sarcli.calibration.reflectors import parse_reflectors
     from sarcli.io.nisar.rslc import read_image
 
-    if config.plots is not None and not Path(config.plots).is_dir():
-        raise ConfigError(f"plot folder {config.plots} does not exist: create it first")
+    if config.plots is not None and Path(config.plots).exists() and not Path(config.plots).is_dir():
+        raise ConfigError(f"plot folder {config.plots} is not a folder")
     with using(provenance):
         reflectors = parse_reflectors(config.reflectors)
         if config.plots is not None:  # every picture the CSV could give, checked before any work
@@ -128,6 +128,7 @@ def run(config: Config, provenance: Provenance | None = None,
         if config.plots is not None:
             from sarcli.calibration.plots import plot_reflector
 
+            Path(config.plots).mkdir(parents=True, exist_ok=True)  # created, as an output file's folder would be
             names = [Path(config.plots) / _plot_name(r.id) for r in res.results]
             dr = float(slc.slant_range[1] - slc.slant_range[0])
             for i, (r, name) in enumerate(zip(res.results, names, strict=True)):

@@ -83,7 +83,8 @@ class DopplerReport(Report):
 
     def lines(self) -> list[str]:
         s = self.summary
-        out = [f"fdc {s.fdc_hz:.2f} Hz = baseband {s.fdc_baseband_hz:.2f} Hz + ({s.ambiguity}) x PRF "
+        out = [f"fdc {s.fdc_hz:.2f} Hz at the scene centre (R = {s.scene_range_m:.0f} m) = baseband "
+               f"{s.fdc_baseband_hz:.2f} Hz + ({s.ambiguity}) x PRF "
                f"[{s.ambiguity_source}{'' if s.ambiguity_resolved else ', NOT RESOLVED'}, confidence "
                f"{s.ambiguity_confidence:.3f}, margin {s.ambiguity_margin_prf:.3f} PRF]; fr {s.fr_hz_per_s:.3f} Hz/s "
                f"[{s.fr_method}]; {s.n_valid_blocks}/{s.n_blocks} blocks valid, {s.n_outlier_blocks} flagged"]

@@ -15,6 +15,7 @@ focus --format nisar-rslc``).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol, runtime_checkable
@@ -161,7 +162,19 @@ class ExportReport(Report):
 
     def lines(self) -> list[str]:
         return [f"wrote {self.output} ({self.format}): {self.shape[0]} lines x {self.shape[1]} samples from "
-                f"{self.input}", *(f"  {k}: {v}" for k, v in self.details.items())]
+                f"{self.input}", *(f"  {k}: {_rounded(v)}" for k, v in self.details.items())]
+
+
+def _rounded(value: Any) -> Any:
+    """A detail for people: floats to 10 significant digits (30109149, not 30109148.999999996), in
+    mappings and lists too."""
+    if isinstance(value, float):
+        return float(f"{value:.10g}")
+    if isinstance(value, dict):
+        return {k: _rounded(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_rounded(v) for v in value)
+    return value
 
 
 def write_format(slc: SLC, output: Path, name: str, options: dict[str, Any] | None = None,
@@ -181,6 +194,10 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     with using(provenance):
         # polarization: the layer to read from an RSLC; for a sarcli SLC (one layer) the name it gets
         slc = read_image(config.input, config.frequency, config.polarization if sniff_rslc(config.input) else None)
+        if slc.first_full_line > slc.last_full_line:
+            warnings.warn(f"{config.input} has no fully focused line (first fully focused line {slc.first_full_line} "
+                          f"after the last, {slc.last_full_line}): every line of the export is partly focused",
+                          stacklevel=2)
         options = dict(config.options)
         layer = config.polarization or (slc.parameters or {}).get("nisar", {}).get("polarization")
         if layer is not None and "polarization" in getattr(fmt.Options, "__dataclass_fields__", {}):

@@ -155,10 +155,11 @@ class FocusReport(Report):
 
     def lines(self) -> list[str]:
         du = self.doppler_used
-        out = [f"focused {Path(self.input).name} -> {self.products['slc']} ({self.shape[0]} x {self.shape[1]}, "
-               f"{self.algorithm}) in {self.timings_s['total_s']:.2f} s; Doppler {self.doppler_source}: fdc "
-               f"{du['fdc_hz_mid']:.1f} Hz, fr {du['fr_hz_per_s_mid']:.2f} Hz/s at mid-swath; peak RSS "
-               f"{self.peak_rss_bytes / 2**20:.0f} MiB"]
+        out = [f"focused {self.input} -> {self.products['slc']} ({self.shape[0]} x {self.shape[1]}, "
+               f"{self.algorithm}) in {self.timings_s['total_s']:.2f} s; Doppler {self.doppler_source}; used at the "
+               f"closest range {du['range_m_mid']:.0f} m, mid-swath (the model read at its beam-centre range R0 / "
+               f"cos(squint), median over the blocks): fdc {du['fdc_hz_mid']:.1f} Hz, "
+               f"fr {du['fr_hz_per_s_mid']:.2f} Hz/s; peak RSS {self.peak_rss_bytes / 2**20:.0f} MiB"]
         out += [f"wrote {v}" for k, v in self.products.items() if k not in ("slc", "crs")]
         return out
 
@@ -174,14 +175,14 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
     if config.doppler is not None:
         from sarcli.io.doppler_product import read_doppler
 
-        return read_doppler(config.doppler), f"read from {Path(config.doppler).name}"
+        return read_doppler(config.doppler), f"read from {config.doppler}"
     if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT
         from sarcli.model.doppler import GeometricDoppler
 
         r_mid = raw.radar.first_range_m + (shape[1] // 2) * C_LIGHT / (2 * raw.radar.range_sampling_rate_hz)
         return (GeometricDoppler.from_centroid_and_rate(config.fdc, config.fr, r_mid, raw.radar.wavelength_m),
-                f"given: fdc {config.fdc:.1f} Hz, fr {config.fr:.2f} Hz/s at {r_mid:.0f} m")
+                f"given as fdc/fr (--fdc/--fr: their values at the beam-centre range {r_mid:.0f} m, mid-swath)")
     from sarcli.doppler.api import estimate_doppler
 
     log.info("no Doppler product given: estimating the centroid and rate from the data")
@@ -262,7 +263,8 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         return FocusReport(
             input=str(config.raw), products=products, algorithm=config.algorithm, doppler_source=how,
             shape=[int(shape[0]), int(shape[1])],
-            doppler_used={"fdc_hz_min": float(np.min(d.fdc_hz)), "fdc_hz_max": float(np.max(d.fdc_hz)),
+            doppler_used={"range_m_mid": float(d.range_m[mid]),
+                          "fdc_hz_min": float(np.min(d.fdc_hz)), "fdc_hz_max": float(np.max(d.fdc_hz)),
                           "fdc_hz_mid": float(np.median(d.fdc_hz[:, mid])),
                           "fr_hz_per_s_min": float(np.min(d.fr_hz_per_s)),
                           "fr_hz_per_s_max": float(np.max(d.fr_hz_per_s)),

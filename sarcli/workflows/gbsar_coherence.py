@@ -87,10 +87,12 @@ class GbsarCoherenceReport(Report):
     time_s: list[float] = field(default_factory=list)
     plot_time_axis: str = "time"
     supported_pixels: int = 0
+    csv: str | None = None
+    plot: str | None = None
 
     def lines(self) -> list[str]:
         return [f"wrote {self.output}: {self.n_ps} PS of {self.supported_pixels} supported pixels "
-                f"(gamma >= {self.threshold})"]
+                f"(gamma >= {self.threshold})"] + [f"wrote {p}" for p in (self.csv, self.plot) if p is not None]
 
 
 def seconds_between(a: str, b: str) -> float:
@@ -229,4 +231,5 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
         return GbsarCoherenceReport(
             output=str(c.output), n_images=len(imgs), n_ps=int(ps_rows.size), threshold=c.threshold,
             max_abs_phase_change_deg=float(np.degrees(np.max(np.abs(phase)))) if ps_rows.size else None,
-            time_s=t.tolist(), plot_time_axis="scan_index" if by_index else "time", supported_pixels=n_supported)
+            time_s=t.tolist(), plot_time_axis="scan_index" if by_index else "time", supported_pixels=n_supported,
+            csv=None if c.csv is None else str(c.csv), plot=None if c.plot is None else str(c.plot))

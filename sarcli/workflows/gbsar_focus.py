@@ -102,10 +102,16 @@ class GbsarFocusReport(Report):
                     f"{g['x_m'][0]:g}..{g['x_m'][1]:g} m, y {g['y_m'][0]:g}..{g['y_m'][1]:g} m at z {g['z_m']:g} m "
                     f"from {self.focus['n_sweeps']} sweeps ({self.focus['track']} track"
                     f"{', reference ranges' if self.focus['reference_range'] else ''}); "
-                    f"{100 * self.focus['full_aperture_fraction']:.0f} % of the pixels seen by every sweep"]
+                    f"{100 * self.focus['full_aperture_fraction']:.0f} % of the pixels seen by every sweep"
+                    ] + self._also()
         used = ", ".join(f"{k} {a:.2f}-{b:.2f} m" for k, (a, b) in self.focus["used"].items())
         return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, {used} "
-                f"(DF minimum range {self.focus['df_min_range_m']:.2f} m)"]
+                f"(DF minimum range {self.focus['df_min_range_m']:.2f} m)"] + self._also()
+
+    def _also(self) -> list[str]:
+        """The pictures written beside the image."""
+        paths = [v["path"] for k, v in self.focus.items() if k.endswith("_geotiff") and isinstance(v, dict)]
+        return [f"wrote {p}" for p in paths + ([self.focus["quicklook"]] if "quicklook" in self.focus else [])]
 
 
 def image_outputs(img: GbsarImage, config: Config) -> dict[str, Any]:
@@ -136,6 +142,8 @@ def image_outputs(img: GbsarImage, config: Config) -> dict[str, Any]:
     elif config.quicklook is not None:
         write_quicklook(config.quicklook, img.image[0], title=f"GB-SAR {img.polarizations[0]} ({img.algorithm})",
                         extent=slant_extent(img), xlabel="azimuth x (m)", ylabel="range R0 (m)", aspect="auto")
+    if config.quicklook is not None:
+        out["quicklook"] = str(config.quicklook)
     return out
 
 

@@ -9,6 +9,8 @@ the coherence is below ``min_coherence``.
 
 from __future__ import annotations
 
+import logging
+import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,7 +22,11 @@ from sarcli.errors import ConfigError
 from sarcli.gbsar.interferometry import MODES, interfere
 from sarcli.io.interferogram import write_interferogram
 from sarcli.workflows.base import Progress, Report, using
-from sarcli.workflows.gbsar_common import guard, load_image, map_outputs, parameters
+from sarcli.workflows.gbsar_common import guard, is_scan, load_image, map_outputs, parameters
+
+_log = logging.getLogger(__name__)
+#: the stages of an interferogram, in order (``timings_s`` keys, progress steps)
+STAGES = ("reference", "secondary", "interferogram", "product", "pictures")
 
 
 @dataclass(frozen=True)
@@ -66,6 +72,7 @@ class GbsarInterfereReport(Report):
     supported_pixels: int
     valid_value_pixels: int
     outputs: dict[str, Any] = field(default_factory=dict)
+    timings_s: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         from sarcli.io.h5common import to_jsonable
@@ -73,24 +80,42 @@ class GbsarInterfereReport(Report):
         return to_jsonable({"output": self.output, **self.attrs, "value": self.value, "unit": self.unit,
                             "rate": self.rate, "mean_coherence": self.mean_coherence,
                             "supported_pixels": self.supported_pixels, "valid_value_pixels": self.valid_value_pixels,
-                            **self.outputs})
+                            **self.outputs, "timings_s": self.timings_s})
 
     def lines(self) -> list[str]:
         return [f"wrote {self.output}: {self.attrs['mode']}, mean coherence {self.mean_coherence or 0:.3f} over "
                 f"{self.supported_pixels} supported pixels, value {self.value} ({self.unit}) on "
-                f"{self.valid_value_pixels} with coherence >= {self.attrs['min_coherence']:g}"]
+                f"{self.valid_value_pixels} with coherence >= {self.attrs['min_coherence']:g}"
+                + (f", in {self.timings_s['total_s']:.1f} s" if self.timings_s else "")]
 
 
 def run(config: Config, provenance=None, progress: Progress | None = None) -> GbsarInterfereReport:
     """Interfere ``config.secondary`` against ``config.reference``; write the product and pictures."""
     c = config
+    t_start = time.perf_counter()
+    timings: dict[str, float] = {}
+    clock = [t_start]
+
+    def done(stage: str, what: str) -> None:
+        now = time.perf_counter()
+        timings[f"{stage}_s"] = now - clock[0]
+        clock[0] = now
+        _log.info("%s in %.2f s", what, timings[f"{stage}_s"])
+        if progress is not None:
+            progress("interfere", STAGES.index(stage) + 1, len(STAGES))
+
     with using(provenance):
         guard([c.reference, c.secondary], [c.output, c.geotiff, c.png, c.value_png, c.value_geotiff, c.coherence_png,
                                            c.coherence_geotiff])
         a = load_image(c.reference)
+        done("reference", f"{'focused the reference scan' if is_scan(c.reference) else 'read the reference'} "
+                          f"{c.reference}")
         b = load_image(c.secondary, like=a)
+        done("secondary", f"{'focused the secondary scan' if is_scan(c.secondary) else 'read the secondary'} "
+                          f"{c.secondary}")
         pol = (c.pol or a.polarizations[0]).upper()
         ifg = interfere(a, b, c.mode, pol, c.window, c.ground_height_m, c.min_coherence)
+        done("interferogram", f"{c.mode} interferogram and coherence")
         attrs = {"mode": c.mode, "pol": pol, "coherence_window": c.window, "ground_height_m": c.ground_height_m,
                  "min_coherence": c.min_coherence,
                  "rail_height_a_m": a.rail_height_m, "rail_height_b_m": b.rail_height_m,
@@ -98,6 +123,7 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
                  "epoch_utc": a.epoch_utc}
         inputs = (c.reference, c.secondary)
         write_interferogram(c.output, ifg, a.range_m, a.azimuth_m, attrs, parameters=parameters(c), inputs=inputs)
+        done("product", f"wrote {c.output}")
         n_valid = int(np.count_nonzero(np.isfinite(ifg.value)))
         outputs = map_outputs(ifg.residual, a, c.geotiff, c.png, f"{c.mode} residual phase ({pol})",
                               "residual interferometric phase, wrapped", "twilight", -np.pi, np.pi, c.map_pixel_m,
@@ -117,10 +143,13 @@ def run(config: Config, provenance=None, progress: Progress | None = None) -> Gb
                                                        f"coherence ({pol}, {c.window} x {c.window} boxcar)",
                                                        "coherence", "gray", 0.0, 1.0, c.map_pixel_m, unit="1",
                                                        inputs=inputs)
+        done("pictures", "pictures and GeoTIFFs")
+        timings["total_s"] = time.perf_counter() - t_start
         if not n_valid:
             warnings.warn(f"no pixel has both images' support and coherence >= {c.min_coherence:g}: the value is "
                           "all NaN", stacklevel=2)
         return GbsarInterfereReport(
             output=str(c.output), attrs=attrs, value=ifg.value_name, unit=ifg.value_unit, rate=ifg.rate,
             mean_coherence=float(np.nanmean(ifg.coherence)) if ifg.support.any() else None,
-            supported_pixels=int(np.count_nonzero(ifg.support)), valid_value_pixels=n_valid, outputs=outputs)
+            supported_pixels=int(np.count_nonzero(ifg.support)), valid_value_pixels=n_valid, outputs=outputs,
+            timings_s=timings)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sarcli.errors import ConfigError, ProductError
+from sarcli.errors import ConfigError, MissingFileError, ProductError
 from sarcli.workflows import base
 
 _log = logging.getLogger(__name__)
@@ -82,7 +82,7 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
         sources = tuple(Path(s) for s in config.sources)
         for s in sources:
             if not s.exists():
-                raise ProductError(f"{s}: no such file")
+                raise MissingFileError(f"{s}: no such file")
         one = sources[0]
         if len(sources) == 1 and config.format is None and one.is_file():
             head = _head(one)

@@ -38,6 +38,7 @@ class QualityReport(Report):
     """One dict per target (metres, dB; ``position_error_*`` against the truth)."""
 
     targets: list[dict[str, Any]] = field(default_factory=list)
+    plot: str | None = None
 
     def lines(self) -> list[str]:
         out = []
@@ -47,6 +48,8 @@ class QualityReport(Report):
                        f"{m['irw_range_m']:.2f} m, az {m['irw_azimuth_m']:.2f} m; PSLR rg {m['pslr_range_db']:.2f} dB, "
                        f"az {m['pslr_azimuth_db']:.2f} dB; ISLR rg {m['islr_range_db']:.2f} dB, az "
                        f"{m['islr_azimuth_db']:.2f} dB{err}")
+        if self.plot is not None:
+            out.append(f"wrote {self.plot}")
         return out
 
 
@@ -72,4 +75,4 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
             plot_point_targets(config.plot, slc.image, targets, float(slc.slant_range[1] - slc.slant_range[0]),
                                azimuth_ground_spacing(slc), title=f"{Path(config.slc).name}: point-target "
                                "impulse responses (ground along-track, slant range)")
-        return QualityReport(targets)
+        return QualityReport(targets, None if config.plot is None else str(config.plot))

@@ -53,11 +53,15 @@ class Report(base.Report):
     n_clutter_patches: int
     seed: int
     simulation_time_s: float
+    writing_time_s: float
+    total_time_s: float
 
     def lines(self) -> list[str]:
+        what = {"hdf5": "HDF5 product", "ceos": "CEOS files", "s1-l0": "s1-l0 packets"}.get(self.format, self.format)
         return [f"simulated {self.scene}: {self.shape[0]} x {self.shape[1]} samples, {self.n_targets} target(s), "
                 f"{self.n_clutter_patches} clutter patch(es), effects: {', '.join(self.effects) or 'none'}",
-                f"wrote {', '.join(self.output)} in {self.simulation_time_s:.2f} s of simulation"]
+                f"wrote {', '.join(self.output)} in {self.total_time_s:.2f} s ({self.simulation_time_s:.2f} s "
+                f"simulating, {self.writing_time_s:.2f} s writing the {what})"]
 
 
 def check_ceos_scene(sc: Any) -> None:
@@ -106,6 +110,7 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
     from sarcli.sim.scene import load_scene
     from sarcli.sim.stripmap import simulate
 
+    t_start = time.perf_counter()
     with base.using(provenance):
         output = Path(config.output)
         written = [output / name for name in SCENE_FILES] if config.format == "ceos" else [output]
@@ -134,6 +139,7 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
         t0 = time.perf_counter()
         raw = simulate(sc, progress=tick)
         elapsed = time.perf_counter() - t0
+        t0 = time.perf_counter()
         if config.format == "ceos":
             from sarcli.io.ceos.radarsat1 import write_ceos
 
@@ -146,7 +152,9 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
             from sarcli.io.raw import write_raw
 
             write_raw(output, raw, parameters=params, inputs=(config.scene,), compression=config.compression)
-        _log.info("simulated in %.3f s, wrote %s", elapsed, ", ".join(map(str, written)))
+        writing = time.perf_counter() - t0
+        _log.info("simulated in %.3f s, wrote %s in %.3f s", elapsed, ", ".join(map(str, written)), writing)
         return Report(scene=sc.name, output=[str(p) for p in written], format=config.format, shape=list(raw.shape),
                       n_channels=raw.n_channels, effects=list(sc.effects), n_targets=len(sc.targets),
-                      n_clutter_patches=len(sc.clutter), seed=sc.seed, simulation_time_s=elapsed)
+                      n_clutter_patches=len(sc.clutter), seed=sc.seed, simulation_time_s=elapsed,
+                      writing_time_s=writing, total_time_s=time.perf_counter() - t_start)

@@ -97,7 +97,7 @@ def test_unknown_step_option_or_value_is_one_line_and_nothing_runs(cli, tmp_path
 def test_a_failing_step_names_itself(cli, tmp_path):
     text = f'[simulate]\nscene = "{SCENE}"\noutput = "OUT/raw.h5"\n\n[orbit_info]\nraw = "OUT/missing.h5"\n'
     r = cli("run", _steps(tmp_path, text))
-    assert r.exit_code == 1 and r.stderr.strip().splitlines() == [
+    assert r.exit_code == 2 and r.stderr.strip().splitlines() == [
         f"sarcli: error: step [orbit_info]: {tmp_path / 'missing.h5'}: no such file"]
     assert (tmp_path / "raw.h5").is_file()  # the step before it ran
 

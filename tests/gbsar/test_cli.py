@@ -115,10 +115,16 @@ def test_interfere_dinsar_and_mismatch(cli, tmp_path):
     b = _scan(cli, tmp_path, "b", minute=30, extra="[effects.displacement]\nscale = 1.0\n")
     out, png, tif = tmp_path / "ifg.h5", tmp_path / "ifg.png", tmp_path / "ifg.tif"
     vtif = tmp_path / "los.tif"
-    r = cli("gbsar", "interfere", a, b, "--mode", "dinsar", "-o", out, "--png", png, "--geotiff", tif,
+    r = cli("-v", "gbsar", "interfere", a, b, "--mode", "dinsar", "-o", out, "--png", png, "--geotiff", tif,
             "--value-geotiff", vtif, "--json")
     assert r.exit_code == 0, r.stderr
     s = json.loads(r.stdout)
+    # where the time went: the two scans focused on the fly, the interferogram, the product, the pictures
+    t = s["timings_s"]
+    assert set(t) == {"reference_s", "secondary_s", "interferogram_s", "product_s", "pictures_s", "total_s"}
+    assert t["total_s"] >= sum(v for k, v in t.items() if k != "total_s") > 0
+    for what in ("focused the reference", "focused the secondary", "interferogram", "wrote"):
+        assert what in r.stderr, what  # -v: one diagnostic per stage
     assert s["rate"]["deg_per_m_los"] == pytest.approx(-12729, rel=0.001) and s["min_coherence"] == 0.5
     d = read_interferogram(out)
     i = int(np.argmin(abs(d["range"] - np.hypot(30.0, 2.0))))

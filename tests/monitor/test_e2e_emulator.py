@@ -106,6 +106,15 @@ def test_landslide_campaign_meets_the_bars(tmp_path):
     gbsar_series.run(gbsar_series.Config(inputs=(out,), out=tmp_path / "rebuilt", jobs=2))
     assert snapshot(tmp_path / "rebuilt") == snapshot(out)
     assert 'id="latest-scan">43<' in (out / "index.html").read_text()
+    # docs/monitoring.md's offline form (the scans by a glob, with the configuration) and its alarms.csv line
+    from tests.conftest import REPO, run_cli
+
+    r = run_cli("gbsar", "series", *sorted((out / "scans").glob("*.h5")), "-c", MONITOR, "--out",
+                tmp_path / "offline", "--jobs", "2")
+    assert r.exit_code == 0, r.stderr
+    alarms = (out / "alarms.csv").read_text()
+    assert (tmp_path / "offline" / "alarms.csv").read_text() == alarms
+    assert alarms.splitlines()[1] in (REPO / "docs" / "monitoring.md").read_text()
 
 
 def _kill_config(tmp_path: Path) -> Path:

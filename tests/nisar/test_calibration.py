@@ -61,6 +61,22 @@ def test_uavsar_csv_quoted_header(tmp_path):
     assert position_at(cr, "2006-07-20T03:15:55Z")[1] == 0.0
 
 
+@pytest.mark.parametrize("header", [
+    "ID,lat,lon,hae,az,el,side",
+    "id, latitude_deg, longitude_deg, height_m, azimuth_deg, tilt_deg, side_length_m",
+    "# reflectors of the site\nID,Lat (deg),Lon (deg),Height (m),Az,Tilt,Side\nname,deg,deg,m,deg,deg,m",
+])
+def test_any_header_rows_before_the_data_are_skipped(tmp_path, header):
+    """docs/nisar.md: header rows are skipped, whatever their words (a row whose six numeric columns hold no
+    number, before the first reflector); a bad number in a reflector's row is still refused."""
+    (cr,) = parse_reflectors(_csv(tmp_path, header + "\nCR1,-9.7,-68.2,120.5,180.0,0.0,2.5\n"))
+    assert (cr.id, cr.latitude_deg, cr.height_m, cr.side_length_m) == ("CR1", -9.7, 120.5, 2.5)
+    with pytest.raises(FormatError, match="line 3: latitude_deg 'x' is not a number"):
+        parse_reflectors(_csv(tmp_path, "ID,lat,lon,hae,az,el,side\nCR1,1,2,3,4,5,6\nCR2,x,2,3,4,5,6\n"))
+    with pytest.raises(FormatError, match="line 3: latitude_deg 'lat' is not"):  # a header after the data: bad
+        parse_reflectors(_csv(tmp_path, "CR1,1,2,3,4,5,6\nCR2,1,2,3,4,5,6\nID,lat,lon,hae,az,el,side\n"))
+
+
 @pytest.mark.parametrize("line, message", [
     ("CR1,1,2,3,4,5", "6 columns"),
     ("CR1,north,2,3,4,5,6", "latitude_deg 'north' is not a number"),
@@ -173,8 +189,9 @@ def test_workflow_refusals(sim_rslc, sim_reflectors_csv, tmp_path):
 
     with pytest.raises(ConfigError, match="search_px"):
         from_mapping(Config, {"slc": "a", "reflectors": "b", "search_px": 0})
-    with pytest.raises(ConfigError, match="plot folder"):
-        run(Config(sim_rslc, sim_reflectors_csv, plots=tmp_path / "absent"))
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(ConfigError, match="plot folder .*a_file is not a folder"):
+        run(Config(sim_rslc, sim_reflectors_csv, plots=tmp_path / "a_file"))
     with pytest.raises(ConfigError, match="has polarizations HH, not VV"):
         run(Config(sim_rslc, sim_reflectors_csv, polarization="VV"))
 
@@ -190,8 +207,7 @@ def test_quality_cli_with_corner_reflectors_and_on_an_rslc(cli, sim_rslc, sim_re
     recs = json.loads(r.stdout)
     assert [tuple(x) for x in recs] == [RECORD_KEYS] * 3
     assert recs == json.loads(json.dumps(run(Config(sim_rslc, sim_reflectors_csv)).records()))
-    plots = tmp_path / "plots"
-    plots.mkdir()
+    plots = tmp_path / "plots"  # created by the command
     r = cli("quality", sim_rslc, "--corner-reflectors", sim_reflectors_csv, "--plots", plots)
     assert r.exit_code == 0 and sorted(p.name for p in plots.iterdir()) == ["cr_T0.png", "cr_T1.png", "cr_T2.png"]
     r = cli("quality", sim_rslc, "--plots", plots)

@@ -57,7 +57,7 @@ def test_export_refuses_overwriting_its_input_and_missing_files(cli, slc_file, t
     r = cli("export", slc_file, "-o", slc_file)
     assert r.exit_code == 2 and "refusing to overwrite an input" in r.stderr
     r = cli("export", tmp_path / "absent.h5", "-o", tmp_path / "x.h5")
-    assert r.exit_code == 1 and "no such file" in r.stderr
+    assert r.exit_code == 2 and "no such file" in r.stderr
 
 
 def test_a_plugin_format_is_used_without_changing_the_command(cli, slc_file, tmp_path):
@@ -111,3 +111,24 @@ def test_info_describes_an_rslc_without_sarcli_provenance(cli, sim_rslc, tmp_pat
     assert s["shape"] == [2048, 1536]
     r = cli("info", other)
     assert r.exit_code == 0 and "NISAR RSLC (L-band" in r.stdout and "frequencyA: HH" in r.stdout
+
+
+def test_export_status_rounds_its_numbers_and_warns_without_a_focused_line(cli, slc_file, tmp_path):
+    """The details are printed to 10 significant digits (no 30109148.999999996); an SLC whose lines are all
+    partly focused (first fully focused line after the last) is exported with a warning saying so."""
+    import re
+
+    import h5py
+
+    r = cli("export", slc_file, "-o", tmp_path / "a.h5")
+    assert r.exit_code == 0, r.stderr
+    numbers = re.findall(r"\d+\.\d+", r.stdout + r.stderr)
+    assert numbers and all(len(n.replace(".", "").lstrip("0")) <= 10 for n in numbers), numbers
+    assert "no fully focused line" not in r.stderr
+    bad = tmp_path / "partial.h5"
+    bad.write_bytes(slc_file.read_bytes())
+    with h5py.File(bad, "r+") as f:
+        f.attrs["first_full_line"], f.attrs["last_full_line"] = 3644, 999
+    r = cli("export", bad, "-o", tmp_path / "b.h5")
+    assert r.exit_code == 0, r.stderr
+    assert "no fully focused line" in r.stderr and "3644" in r.stderr

@@ -75,8 +75,8 @@ def test_batch_here(cli, scenes, tmp_path):
 
 
 def test_a_failing_step_skips_the_rest_of_its_scene_only(cli, scenes, tmp_path):
-    """A raw product the focus refuses (a LOCAL orbit cannot make a GeoTIFF) fails its focus step; the
-    other scenes are done."""
+    """A raw product the focus refuses (a LOCAL orbit cannot make the GeoTIFF asked for with geotiff =
+    always) fails its focus step; the other scenes are done."""
     from sarcli.workflows.batch import Config, run
 
     inp = tmp_path / "in"
@@ -85,7 +85,7 @@ def test_a_failing_step_skips_the_rest_of_its_scene_only(cli, scenes, tmp_path):
     shutil.copy(scenes / "a.h5", inp / "flat.h5")
     with h5py.File(inp / "flat.h5", "r+") as f:
         f["orbit"].attrs["frame"] = "LOCAL"
-    rep = run(Config(input=inp, output=tmp_path / "out", workers=0))
+    rep = run(Config(input=inp, output=tmp_path / "out", workers=0, geotiff="always"))
     assert [(s["scene"], s["steps"]) for s in rep.scenes] == [
         ("a", {"doppler": "done", "focus": "done"}), ("flat", {"doppler": "done", "focus": "failed"})]
     assert rep.failures[0]["scene"] == "flat" and "GeoTIFF needs an Earth orbit" in rep.failures[0]["error"]
@@ -140,3 +140,75 @@ def test_the_batch_command_module_loads_no_heavy_package():
             "{'numpy', 'h5py', 'scipy', 'numba', 'rasterio', 'matplotlib', 'dask', 'distributed'}))")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert r.stdout.strip() == "[]", r.stdout
+
+
+@pytest.mark.slow
+def test_a_scene_without_an_orbit_is_focused_without_its_geotiff(cli, scenes, tmp_path):
+    """--geotiff auto (default): a scene without an Earth orbit gets its SLC and quicklook, no GeoTIFF, and a
+    warning in its report; --geotiff never: no GeoTIFF for any scene; always: the orbit-less scene fails."""
+    inp = tmp_path / "in"
+    inp.mkdir()
+    shutil.copy(scenes / "a.h5", inp / "bare.h5")
+    with h5py.File(inp / "bare.h5", "r+") as f:
+        for name in ("orbit", "orbit_ecef", "attitude"):
+            del f[name]
+    out = tmp_path / "out"
+    r = cli("batch", inp, "-o", out, "--workers", "0", "--json")
+    assert r.exit_code == 0, r.stderr
+    assert json.loads(r.stdout)["scenes"][0]["steps"] == {"doppler": "done", "focus": "done"}
+    assert (out / "bare.slc.h5").is_file() and (out / "bare.png").is_file() and not (out / "bare.tif").exists()
+    focus = json.loads((out / "bare.json").read_text())["steps"][1]
+    assert any("no GeoTIFF" in w and "no Earth orbit" in w for w in focus["warnings"]), focus["warnings"]
+    assert "--geotiff" not in focus["report"]["products"] and "geotiff" not in focus["report"]["products"]
+    r = cli("batch", inp, "-o", tmp_path / "always", "--workers", "0", "--geotiff", "always")
+    assert r.exit_code == 1 and "GeoTIFF needs an Earth orbit" in r.stderr
+    r = cli("batch", inp, "-o", tmp_path / "o", "--workers", "0", "--focus", "geotiff=null")
+    assert r.exit_code == 2 and "--geotiff auto|always|never" in r.stderr
+
+
+def test_matlab_blocks_are_scenes_in_folders_of_their_own(tmp_path):
+    """A MATLAB block is two files (block and run parameters): a folder holding both is one scene (read by
+    matlab-cw); loose MAT files are listed as ignored, saying how to make them a scene, and a folder with
+    nothing else names what it ignored."""
+    import numpy as np
+    import scipy.io
+
+    from sarcli.errors import ConfigError
+    from sarcli.workflows.batch import Config, discover, run
+
+    inp = tmp_path / "in"
+    (inp / "blk").mkdir(parents=True)
+    levels = 2 * np.random.default_rng(1).integers(-8, 8, size=(2, 32, 64)) + 1
+    scipy.io.savemat(inp / "blk" / "block.mat", {"data": levels[0] + 1j * levels[1]})
+    scipy.io.savemat(inp / "blk" / "run_params.mat", {"f0": 5.3e9, "Fr": 32.317e6, "Kr": 0.72135e12, "Tr": 41.75e-6,
+                                                      "PRF": 1256.98, "R0": 988647.462, "c": 2.9979e8})
+    scenes, ignored, bad = discover(inp)
+    assert [(s.name, s.reader) for s in scenes] == [("blk", "matlab-cw")] and not ignored and not bad
+    loose = tmp_path / "loose"
+    loose.mkdir()
+    for name in ("block.mat", "run_params.mat"):
+        shutil.copy(inp / "blk" / name, loose / name)
+    with pytest.raises(ConfigError) as e:
+        run(Config(input=loose, output=tmp_path / "out", workers=0))
+    msg = str(e.value)
+    assert "no raw products or sensor inputs" in msg and "ignored: block.mat (" in msg and "run_params.mat (" in msg
+    assert "a folder of its own" in msg
+
+
+def test_a_matlab_block_folder_ingests(cli, tmp_path):
+    """`sarcli ingest FOLDER` reads a folder holding a block and its run parameters, as --matlab/--params do."""
+    import numpy as np
+    import scipy.io
+
+    levels = 2 * np.random.default_rng(1).integers(-8, 8, size=(2, 32, 64)) + 1
+    (tmp_path / "blk").mkdir()
+    scipy.io.savemat(tmp_path / "blk" / "block.mat", {"data": levels[0] + 1j * levels[1]})
+    scipy.io.savemat(tmp_path / "blk" / "p.mat", {"f0": 5.3e9, "Fr": 32.317e6, "Kr": 0.72135e12, "Tr": 41.75e-6,
+                                                  "PRF": 1256.98, "R0": 988647.462, "c": 2.9979e8})
+    r = cli("ingest", tmp_path / "blk", "-o", tmp_path / "a.h5", "--json")
+    assert r.exit_code == 0, r.stderr
+    r2 = cli("ingest", "--matlab", tmp_path / "blk" / "block.mat", "--params", tmp_path / "blk" / "p.mat", "-o",
+             tmp_path / "b.h5", "--json")
+    with h5py.File(tmp_path / "a.h5") as a, h5py.File(tmp_path / "b.h5") as b:
+        assert np.array_equal(a["echo"][...], b["echo"][...])
+    assert json.loads(r.stdout)["first_range_m"] == json.loads(r2.stdout)["first_range_m"]

@@ -68,3 +68,57 @@ def test_exit_codes(cli, tmp_path, monkeypatch):
     monkeypatch.setattr(export, "run", interrupted)
     r = cli("export", junk, "-o", tmp_path / "x.nitf", "--format", "sicd")
     assert r.exit_code == 130 and r.stderr.strip() == "sarcli: error: interrupted"
+
+
+@pytest.mark.parametrize("args", [
+    ("info", "{nope}"), ("focus", "{nope}", "-o", "{out}"), ("doppler", "{nope}", "-o", "{out}"),
+    ("quality", "{nope}"), ("export", "{nope}", "-o", "{out}"), ("ingest", "{nope}", "-o", "{out}"),
+    ("ingest", "--matlab", "{nope}", "--params", "{nope}", "-o", "{out}"),
+    ("orbit", "info", "{nope}"), ("gbsar", "focus", "{nope}", "-o", "{out}"), ("run", "{nope}"),
+    ("simulate", "{nope}", "-o", "{out}")])
+def test_a_missing_input_file_is_a_usage_error(cli, tmp_path, args):
+    """README, docs/cli.md and docs/architecture.md agree: a missing input file is a usage mistake, exit 2,
+    one line naming the file, whichever command reads it."""
+    nope, out = tmp_path / "nope.h5", tmp_path / "out.h5"
+    r = cli(*(a.format(nope=nope, out=out) for a in args))
+    lines = r.stderr.strip().splitlines()
+    assert r.exit_code == 2 and len(lines) == 1, r.stderr
+    assert lines[0].startswith("sarcli: error: ") and str(nope) in lines[0] and "no such file" in lines[0]
+
+
+@pytest.mark.parametrize("args", [
+    ("--bogus",), ("focus", "--bogus"), ("gbsar", "focus", "--bogus"), ("gbsar", "--bogus"),
+    ("orbit", "info", "--bogus"), ("info", "a.h5", "b", "c", "--json", "--jsno"), ("frobnicate",),
+    ("gbsar", "frobnicate"), ("focus", "--fdc"), ("simulate", "x.toml", "--format", "tiff")])
+def test_a_usage_mistake_is_one_line_with_exit_2(cli, args):
+    """Click's own usage errors (unknown option or command, missing value, bad choice) read like every other
+    error: one line ``sarcli: error: ...`` naming the command and where to find its options, exit 2."""
+    r = cli(*args)
+    lines = r.stderr.strip().splitlines()
+    assert r.exit_code == 2 and len(lines) == 1, r.stderr
+    assert lines[0].startswith("sarcli: error: ") and "-h" in lines[0], lines[0]
+    assert "Usage:" not in r.stderr and "Try '" not in r.stderr
+
+
+def test_every_command_says_what_it_wrote(cli, small, tmp_path):
+    """Each file a command writes is named in its status ("wrote PATH"), with the folder as given."""
+    from pathlib import Path
+
+    samples = Path(__file__).parents[2] / "samples"
+    d = tmp_path / "out"
+    d.mkdir()
+    runs = [
+        (("gbsar", "simulate", samples / "gbsar_p1.toml", "-o", d / "p1.h5"), [d / "p1.h5"]),
+        (("gbsar", "simulate", samples / "gbsar_p2.toml", "-o", d / "p2.h5"), [d / "p2.h5"]),
+        (("gbsar", "focus", d / "p1.h5", "-o", d / "i.h5", "--quicklook", d / "i.png"), [d / "i.h5", d / "i.png"]),
+        (("gbsar", "coherence", d / "p1.h5", d / "p2.h5", "-o", d / "ps.h5", "--csv", d / "ps.csv", "--plot",
+          d / "ps.png"), [d / "ps.h5", d / "ps.csv", d / "ps.png"]),
+        (("quality", small.slc, "--plot", d / "irf.png"), [d / "irf.png"]),
+    ]
+    for args, written in runs:
+        r = cli(*args)
+        assert r.exit_code == 0, r.stderr
+        for p in written:
+            assert p.is_file() and f"wrote {p}" in r.stdout + r.stderr, (args[:2], p)
+    r = cli("focus", small.raw, "-o", d / "slc.h5", "--fdc", "-6558", "--fr", "-1781")
+    assert f"focused {small.raw} -> {d / 'slc.h5'}" in r.stderr  # the input's folder kept

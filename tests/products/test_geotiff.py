@@ -88,7 +88,7 @@ def test_tags_units_and_gcps(tmp_path):
     assert float(t["WAVELENGTH_M"]) == 0.0566 and json.loads(t["EXTRA"]) == {"k": 1}
     assert t["ACQUISITION_START_UTC"] == "2002-06-16T15:41:01.750000Z"
     assert t["ACQUISITION_STOP_UTC"] == "2002-06-16T15:41:03.500000Z"
-    assert json.loads(t["INPUTS"]) == [{"path": "in.h5", "sha256": _sha(src)}]
+    assert json.loads(t["INPUTS"]) == [{"path": str(src), "sha256": _sha(src)}]
     assert t["TIFFTAG_SOFTWARE"].startswith("sarcli ")
     created = dt.datetime.strptime(t["CREATED_UTC"], "%Y-%m-%dT%H:%M:%S.%fZ")
     assert t["TIFFTAG_DATETIME"] == created.strftime("%Y:%m:%d %H:%M:%S")
@@ -132,7 +132,7 @@ def test_focus_geotiffs(small):
         e = dt.datetime.fromisoformat(epoch.replace("Z", "+00:00"))
         assert t["ACQUISITION_START_UTC"] == (e + dt.timedelta(seconds=float(t0))).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
         assert t["ACQUISITION_STOP_UTC"] == (e + dt.timedelta(seconds=float(t1))).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
-        assert json.loads(t["INPUTS"]) == [{"path": "slc.h5", "sha256": _sha(small.slc)}]
+        assert json.loads(t["INPUTS"]) == [{"path": str(small.slc), "sha256": _sha(small.slc)}]
         assert t["FULLY_FOCUSED_LINES"].startswith(f"{first}..{last} of {n}")
         assert (tif.with_suffix(".qml")).is_file()
     with rasterio.open(small.slant_tif) as ds:
@@ -160,7 +160,7 @@ def test_gbsar_geotiffs_nan_for_no_signal_and_tagged(cli, tmp_path):
         t = ds.tags()
     assert np.isnan(v).any() and np.isfinite(v).any()
     assert np.nanmin(v) > -190.0  # no -200 dB floor: pixels without signal are nodata
-    assert json.loads(t["INPUTS"]) == [{"path": "img.h5", "sha256": _sha(img)}]
+    assert json.loads(t["INPUTS"]) == [{"path": str(img), "sha256": _sha(img)}]
     assert float(t["WAVELENGTH_M"]) == pytest.approx(C / 5.3e9) and t["SENSOR"] == "GB-SAR"
     assert t["ACQUISITION_START_UTC"].startswith("2024-05-01T10:00")
     outs = {k: tmp_path / f"{k}.tif" for k in ("phase", "los", "coh")}
@@ -267,4 +267,29 @@ def test_the_slc_is_hashed_once_beside_the_quicklook(small, tmp_path, monkeypatc
     assert r.exit_code == 0, r.stderr
     assert len(reads) == 1 and reads[0].startswith("sarcli-sha256"), reads
     with rasterio.open(tmp_path / "m.tif") as d:
-        assert json.loads(d.tags()["INPUTS"]) == [{"path": "slc.h5", "sha256": _sha(tmp_path / "slc.h5")}]
+        slc = tmp_path / "slc.h5"
+        assert json.loads(d.tags()["INPUTS"]) == [{"path": str(slc), "sha256": _sha(slc)}]
+
+
+def test_focus_is_byte_identical_under_source_date_epoch(small, tmp_path, monkeypatch):
+    """README: with SOURCE_DATE_EPOCH set, products are byte-identical between runs. focus twice: the SLC
+    (no wall-clock timings stored then) and the GeoTIFF (whose INPUTS tag is the SLC's hash) are the same
+    bytes; the timings are still reported (--json) and stored when SOURCE_DATE_EPOCH is unset."""
+    import h5py
+
+    from tests.conftest import run_cli
+
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    runs = []
+    for _ in range(2):  # the same command (the command line and the paths are part of the provenance)
+        r = run_cli("focus", small.raw, "-o", tmp_path / "slc.h5", "--range-window", "rect", "--looks-az",
+                    "2", "--geotiff", tmp_path / "amp.tif", "--json")
+        assert r.exit_code == 0, r.stderr
+        assert json.loads(r.stdout)["timings_s"]["total_s"] > 0
+        runs.append({name: (tmp_path / name).read_bytes() for name in ("slc.h5", "amp.tif")})
+        for name in runs[-1]:
+            (tmp_path / name).unlink()
+    for name in runs[0]:
+        assert runs[0][name] == runs[1][name], name
+    with h5py.File(small.slc) as f:  # focused without SOURCE_DATE_EPOCH: the focuser's timings are kept
+        assert len(f["timings"].attrs) > 0 and all(v > 0 for v in f["timings"].attrs.values())

@@ -64,5 +64,95 @@ def test_quality_plot_and_time_axis_note(cli, small, tmp_path):
     lead = float(np.mean(tg["beam_center_time_s"] - tg["zero_doppler_time_s"]))  # the simulator's own times
     label = time_axis_label(slc)
     shown = float(label.split("this ")[1].split(" s")[0])
-    assert label.startswith("zero-Doppler time (s)") and shown == pytest.approx(lead, abs=0.05)
+    assert label.startswith("zero-Doppler time (UTC, ") and shown == pytest.approx(lead, abs=0.05)
     assert lead > 3.0  # RADARSAT-1's squint: the -3.7 s of the issue
+
+
+def _drawn(monkeypatch, draw):
+    """The matplotlib figure ``draw()`` saves (captured at savefig, drawn so its tick labels exist)."""
+    from matplotlib.figure import Figure
+
+    figs = []
+    real = Figure.savefig
+
+    def keep(self, *a, **k):
+        self.canvas.draw()
+        figs.append(self)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    draw()
+    return figs[-1]
+
+
+def test_quicklook_time_axis_in_utc_and_partly_focused_lines_marked(small, tmp_path, monkeypatch):
+    """The time axis reads UTC clock times (no '+9.268e3' offset), labelled with the date; the lines
+    without their whole aperture are shaded and named in the legend; an SLC without a fully focused line
+    says so in the title."""
+    import dataclasses
+    import datetime as dt
+
+    from sarcli.focus.quicklook import write_slc_quicklook
+    from sarcli.io.slc import read_slc
+
+    slc = read_slc(small.slc)
+    fig = _drawn(monkeypatch, lambda: write_slc_quicklook(tmp_path / "q.png", slc, 2, 1))
+    ax = fig.axes[0]
+    epoch = dt.datetime.fromisoformat(slc.epoch_utc.replace("Z", "+00:00"))
+    labels = [t.get_text() for t in ax.get_yticklabels() if t.get_text()]
+    assert labels and ax.yaxis.get_offset_text().get_text() == ""
+    for t, text in zip(ax.get_yticks(), [t.get_text() for t in ax.get_yticklabels()], strict=True):
+        if text:
+            assert text == (epoch + dt.timedelta(seconds=float(t))).strftime("%H:%M:%S.%f")[:11]
+    assert "UTC" in ax.get_ylabel() and epoch.strftime("%Y-%m-%d") in ax.get_ylabel()
+    n = slc.azimuth_time.size
+    partly = slc.first_full_line > 0 or slc.last_full_line < n - 1
+    legend = ax.get_legend()
+    assert partly and legend is not None and "partly focused" in legend.get_texts()[0].get_text()
+    none = dataclasses.replace(slc, first_full_line=n, last_full_line=-1)
+    fig = _drawn(monkeypatch, lambda: write_slc_quicklook(tmp_path / "none.png", none, 2, 1))
+    assert "no fully focused line" in fig.axes[0].get_title()
+
+
+@pytest.mark.slow
+def test_quality_plot_titles_inside_the_picture(cli, small, tmp_path, monkeypatch):
+    """Every panel title of the impulse-response picture stays over its own column: right of the panel on
+    its left and inside the figure with a margin (the one-line title reached the right edge)."""
+    fig = _drawn(monkeypatch, lambda: cli("quality", small.slc, "--plot", tmp_path / "irf.png"))
+    width = fig.bbox.width
+    boxes = [ax.get_window_extent() for ax in fig.axes]
+    checked = 0
+    for ax, own in zip(fig.axes, boxes, strict=True):
+        if not ax.get_title():
+            continue
+        box = ax.title.get_window_extent()
+        left = max([b.x1 for b in boxes if b.x1 <= own.x0 + 1 and b.y0 < own.y1 and b.y1 > own.y0], default=0.0)
+        assert left <= box.x0 and box.x1 <= width - 10, (ax.get_title(), box.x0, box.x1, left, width)
+        checked += 1
+    assert checked >= 6  # three panels per target, two targets
+
+
+@pytest.mark.slow
+def test_doppler_plot_without_an_orbit_lists_only_what_it_draws(cli, small, tmp_path, monkeypatch):
+    """A raw product without an orbit: no 'orbit + attitude geometry' or 'geometric seed' entries (they
+    would have no line); every legend entry of every panel has finite data."""
+    import shutil
+
+    import h5py
+
+    raw = tmp_path / "bare.h5"
+    shutil.copy(small.raw, raw)
+    with h5py.File(raw, "r+") as f:
+        for name in ("orbit", "orbit_ecef", "attitude"):
+            if name in f:
+                del f[name]
+    fig = _drawn(monkeypatch, lambda: cli("doppler", raw, "--plot", tmp_path / "d.png"))
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        labels = [t.get_text() for t in legend.get_texts()]
+        assert not any("geometr" in x or "orbit" in x for x in labels), labels
+        for line in ax.get_lines():
+            if not line.get_label().startswith("_"):
+                assert np.isfinite(np.asarray(line.get_ydata(), float)).any(), line.get_label()

@@ -3,6 +3,9 @@ header field and every decoded sample equals the independent reference decode, b
 
 from __future__ import annotations
 
+import json
+
+import h5py
 import numpy as np
 import pytest
 
@@ -117,3 +120,22 @@ def test_echo_packet_physics(s1_packets):
     assert abs(f0 + k * t / 2) < 37.53472224e6 / 2**14
     assert 0 < k * t < H.range_sampling_rate_hz(int(h["range_decimation"][0]))
     assert int(h["range_decimation"][0]) == 4 and int(h["ecc_number"][0]) == 13  # S3
+
+
+def test_the_packet_folder_ingests_its_echo_file(cli, s1_packets, tmp_path):
+    """Ingesting the folder takes the echo file beside the noise and calibration files (each with only
+    noise or calibration packets: named as skipped), not stop at the first one; the product is the echo
+    file's own."""
+    r = cli("ingest", s1_packets, "-o", tmp_path / "folder.h5", "--json")
+    assert r.exit_code == 0, r.stderr
+    doc = json.loads(r.stdout)
+    assert doc["shape"] == [1, 21558] and doc["source"] == "sentinel1-l0"
+    skipped = [n for n in doc["notes"] if "no echo packets" in n]
+    assert len(skipped) == 2 and any("000000-noise.dat" in n for n in skipped)
+    assert any("000008-txcal.dat" in n for n in skipped)
+    r = cli("ingest", s1_packets / "000408-echo.dat", "-o", tmp_path / "file.h5")
+    assert r.exit_code == 0, r.stderr
+    with h5py.File(tmp_path / "folder.h5") as a, h5py.File(tmp_path / "file.h5") as b:
+        assert np.array_equal(a["echo"][...], b["echo"][...])
+    r = cli("ingest", s1_packets / "000000-noise.dat", "-o", tmp_path / "noise.h5")  # one file: still refused
+    assert r.exit_code == 1 and "no echo packets" in r.stderr

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +28,7 @@ def test_level0_scene_focuses_like_the_hdf5_scene(cli, tmp_path):
 
     r = cli("simulate", SAMPLE, "--format", "s1-l0", "-o", tmp_path / "s1.dat")
     assert r.exit_code == 0, r.stderr
+    assert re.search(r"in \d+\.\d\d s \(\d+\.\d\d s simulating, \d+\.\d\d s writing the s1-l0 packets\)", r.stderr)
     assert cli("simulate", SAMPLE, "-o", tmp_path / "sim.h5").exit_code == 0
     r = cli("ingest", tmp_path / "s1.dat", "-o", tmp_path / "l0.h5")
     assert r.exit_code == 0, r.stderr

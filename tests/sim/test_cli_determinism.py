@@ -55,6 +55,9 @@ def test_cli_json_and_product_contents(cli, tmp_path):
     assert r.exit_code == 0, r.stderr
     out = json.loads(r.stdout)
     assert out["shape"] == [128, 400] and out["effects"] == ["range_migration", "earth_rotation"]
+    # the whole time is reported, not only the simulation's: scene, simulation, writing the product
+    assert out["total_time_s"] >= out["simulation_time_s"] + out["writing_time_s"] > 0
+    assert out["writing_time_s"] > 0
     raw = read_raw(tmp_path / "raw.h5")
     assert raw.orbit.frame == "ECI" and raw.orbit.time.size == 15
     assert np.allclose(np.diff(raw.orbit.time), 480.0)

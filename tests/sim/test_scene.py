@@ -76,7 +76,7 @@ def test_unreachable_slant_range_is_one_line(orbit_scene):
 
 
 @pytest.mark.parametrize("content, message", [
-    (None, "scene file not found"),
+    (None, "no such file"),
     ("[scene]\nseed = 1\neffects = ['nope']\n", "missing table [radar]"),
     (orbit_scene_text(effects=("warp_drive",)), "unknown effect 'warp_drive'"),
 ])

@@ -25,6 +25,9 @@ def batch(
     focus: list[str] = typer.Option(None, "--focus", metavar="KEY=VALUE", help="A 'sarcli focus' setting for every "
                                     "scene, as in a [focus] table: looks_az=4, height_m=300, "
                                     "options={block_lines=2048} (repeatable)."),
+    geotiff: str = typer.Option(None, "--geotiff", metavar="[auto|always|never]",
+                                help="GeoTIFFs: auto (default) for every scene with an Earth orbit, a scene without "
+                                     "one gets its SLC and quicklook and a warning; always; never."),
     as_json: bool = typer.Option(False, "--json", help="Print the batch report as JSON on stdout."),
 ) -> None:
     """Process a folder of scenes: raw -> Doppler -> SLC + GeoTIFF + quicklook, as one task graph.
@@ -48,7 +51,7 @@ def batch(
     """
     rep = run_workflow("batch", {"input": input_dir, "output": output, "scheduler": scheduler, "workers": workers,
                                  "threads_per_worker": threads_per_worker, "report": report, "retries": retries,
-                                 "focus": parse_option_values(focus or [], "--focus")},
+                                 "focus": parse_option_values(focus or [], "--focus"), "geotiff": geotiff},
                        flags={"input": "IN", "output": "--output"})
     if as_json:
         emit_json(rep.to_dict())

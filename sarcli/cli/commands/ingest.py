@@ -26,6 +26,9 @@ def ingest(
     epoch: str = typer.Option(None, "--epoch", help="MATLAB only: ISO-8601 UTC time of line 1 of the pass."),
     agc: Path = typer.Option(None, "--agc", help="MATLAB only: the pass's AGC table (AGC_attenuation_values.mat); "
                                                  "its attenuation is stored per line and undone by the processing."),
+    orbit: Path = typer.Option(None, "--orbit", metavar="FILE",
+                               help="MATLAB only: the pass's state vectors (CSV: time_utc,x,y,z,vx,vy,vz in m and "
+                                    "m/s, Earth-fixed; or an ESA orbit file, .EOF); needs --epoch."),
     first_line: str = typer.Option(None, "--first-line", metavar="N|auto",
                                    help="MATLAB only: the block's first line in the pass (1-based; default: the "
                                         "params file's first_rg_line; auto: found from the line power vs --agc)."),
@@ -53,7 +56,7 @@ def ingest(
     file or a .SAFE folder), and any installed plug-in. Several data sets in one input (swaths,
     polarizations): one product each, in the folder -o, or STEM_NAME.h5 for -o STEM.h5. Reader
     options: --option KEY=VALUE; --keep-partial (CEOS, Sentinel-1), --missing, --max-gap, --f3-pulses
-    (CEOS) and --epoch, --agc, --first-line, --first-cell (MATLAB) are shortcuts. A MATLAB block is placed
+    (CEOS) and --epoch, --agc, --orbit, --first-line, --first-cell (MATLAB) are shortcuts. A MATLAB block is placed
     in its pass (azimuth time from the start line, near range from the start cell); with --agc the
     start line is checked against the table (a contradicted one is refused, naming the line that fits).
     Nothing is written to the inputs. CEOS: missing lines are found from the aux-block clock against
@@ -74,6 +77,9 @@ def ingest(
 
       sarcli ingest --matlab rs1_vancouver_block1.mat --params rs1_vancouver_run_params.mat
       --agc AGC_attenuation_values.mat --first-line auto --first-cell 1050 -o van.h5
+
+      sarcli ingest --matlab block.mat --params run_params.mat --epoch UTC_OF_LINE_1
+      --orbit orbit.csv -o block.h5   (an orbit: the block can be geocoded)
 
       sarcli ingest demo/ceos --format ceos-rs1 --option max_gap=50 -o raw.h5 --json
 
@@ -96,7 +102,8 @@ def ingest(
             raise ConfigError(f"--first-line must be a line number or auto, got {first_line!r}")
         first_line = int(first_line)
     sugar = {"keep_partial": keep_partial or None, "missing": missing, "max_gap": max_gap, "f3_pulses": f3_pulses,
-             "epoch": epoch, "agc": None if agc is None else str(agc), "first_line": first_line,
+             "epoch": epoch, "agc": None if agc is None else str(agc),
+             "orbit": None if orbit is None else str(orbit), "first_line": first_line,
              "first_cell": first_cell}
     for key, value in sugar.items():
         if value is not None:

@@ -31,7 +31,7 @@ def quality(
     corner_reflectors: Path = typer.Option(None, "--corner-reflectors", help="Surveyed corner reflectors (NISAR or "
                                            "UAVSAR CSV): offsets from the orbit's prediction and the IRF of each."),
     plots: Path = typer.Option(None, "--plots", help="With --corner-reflectors: a folder for one IRF PNG per "
-                               "reflector."),
+                               "reflector (created if missing)."),
     plot: Path = typer.Option(None, "--plot", help="PNG of the point targets' impulse responses: range and "
                               "azimuth cuts and 2-D contours, one row per target."),
     frequency: str = typer.Option(None, "--frequency", help="NISAR RSLC layer: frequency A or B (default: first)."),

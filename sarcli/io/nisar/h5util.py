@@ -26,7 +26,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from sarcli.errors import FormatError, ProductError
+from sarcli.errors import FormatError, MissingFileError, ProductError
 
 BANDS = ("LSAR", "SSAR")
 _UNITS = re.compile(r"^\s*seconds?\s+since\s+(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(\.\d+)?\s*(Z|UTC)?\s*$",
@@ -48,7 +48,7 @@ def open_h5(path: str | os.PathLike) -> Iterator[h5py.File]:
     """Open an existing HDF5 file read-only; a missing, unreadable or truncated file is one line."""
     p = Path(path)
     if not p.exists():
-        raise ProductError(f"{p}: no such file")
+        raise MissingFileError(f"{p}: no such file")
     try:
         f = h5py.File(p, "r")
     except OSError as e:

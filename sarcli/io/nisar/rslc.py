@@ -55,7 +55,7 @@ import numpy as np
 from orbit.errors import OrbitError
 from orbit.statevectors import StateVectors
 from sarcli import __version__
-from sarcli.errors import ConfigError, FormatError, ProductError
+from sarcli.errors import ConfigError, FormatError, MissingFileError, ProductError
 from sarcli.io.h5common import atomic_h5, created_utc, dataset, group, to_jsonable
 from sarcli.io.nisar.attitude import model_attitude, quaternions_from_model
 from sarcli.io.nisar.h5util import (
@@ -786,7 +786,7 @@ def read_image(path: str | os.PathLike, frequency: str | None = None, polarizati
         return read_rslc(path, frequency, polarization)
     if frequency is not None or polarization is not None:
         if not Path(path).exists():
-            raise ProductError(f"{path}: no such file")
+            raise MissingFileError(f"{path}: no such file")
         raise ConfigError(f"{path}: a sarcli SLC product has one image: --frequency/--polarization apply to NISAR "
                           "RSLC files only")
     return read_slc(path)

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
-from sarcli.errors import ConfigError, ProductError, SarcliError
+from sarcli.errors import ConfigError, MissingFileError, ProductError, SarcliError
 from sarcli.model.raw import RawProduct
 from sarcli.registry import Registry
 
@@ -91,7 +91,7 @@ def find_reader(sources: Sequence[Path], name: str | None = None) -> SensorReade
     """
     for s in sources:
         if not Path(s).exists():
-            raise ProductError(f"{s}: no such file")
+            raise MissingFileError(f"{s}: no such file")
     if name is not None:
         return READERS.get(name)
     diagnoses: list[tuple[str, SarcliError]] = []

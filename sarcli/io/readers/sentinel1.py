@@ -2,7 +2,8 @@
 
 Sources: one measurement file (a stream of packets, ``s1?-*-raw-*.dat``), or a ``.SAFE`` folder
 (every ``measurement``-level ``.dat`` that is not an ``-index.dat`` or ``-annot.dat``: one file
-per polarisation; the index and annotation files are not needed and not read). Decoding is in
+per polarisation; the index and annotation files are not needed and not read), or a folder of packet
+files. In a folder, a file with no echo packets (noise or calibration only) is skipped with a note. Decoding is in
 :mod:`sarcli.io.sentinel1`; this adapts it to the reader interface (:mod:`sarcli.io.readers`).
 """
 
@@ -63,20 +64,30 @@ class Sentinel1Reader:
         return all(p.is_file() and looks_like_packets(p) for p in files)
 
     def read(self, sources: Sequence[Path], options: Sentinel1Options) -> Ingested:
-        from sarcli.io.sentinel1.product import read_level0
+        from sarcli.io.sentinel1.product import NoEchoPackets, read_level0
 
         if len(sources) != 1:
             raise ConfigError("give one Level-0 measurement .dat file or one .SAFE folder")
         files = _measurement_files(Path(sources[0]))
-        products, notes = {}, []
+        products, notes, skipped = {}, [], []
         for path in files:
-            l0 = read_level0(path, allow_truncated=options.keep_partial)
+            try:
+                l0 = read_level0(path, allow_truncated=options.keep_partial)
+            except NoEchoPackets as e:
+                if len(files) == 1:
+                    raise
+                skipped.append(path)
+                notes.append(f"{path.name}: skipped ({str(e).split(': ', 1)[1]})")
+                continue
             for name, raw in l0.products.items():
                 if name in products:
                     raise FormatError(f"{path}: data set {name} also comes from another file of {sources[0]}")
                 products[name] = raw
             notes += [f"{path.name}: {n}" for n in l0.notes]
-        return Ingested(products, tuple(files), {"format": self.name, **to_mapping(options)}, notes)
+        if not products:
+            raise FormatError(f"{sources[0]}: no echo packets in any of its {len(files)} measurement files")
+        used = tuple(p for p in files if p not in skipped)
+        return Ingested(products, used, {"format": self.name, **to_mapping(options)}, notes)
 
 
 READER = Sentinel1Reader()

@@ -78,6 +78,10 @@ class Level0:
     notes: list[str] = field(default_factory=list)
 
 
+class NoEchoPackets(FormatError):
+    """A measurement file with only noise or calibration packets: nothing to make a raw product of."""
+
+
 def read_packets(path: str | os.PathLike, allow_truncated: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(file bytes, checked header table) of a Level-0 measurement file."""
     try:
@@ -247,7 +251,7 @@ def read_level0(path: str | os.PathLike, allow_truncated: bool = False) -> Level
     sig = h["signal_type"]
     echo = np.flatnonzero(sig == SIGNAL_ECHO)
     if echo.size == 0:
-        raise FormatError(f"{where}: no echo packets among {h.size} (signal types "
+        raise NoEchoPackets(f"{where}: no echo packets among {h.size} (signal types "
                           f"{sorted(set(sig.tolist()))}): nothing to make a raw product of")
     pol = _polarisation(h)
     names = np.array([swath_name(e, r, s) for e, r, s in zip(h["ecc_number"], h["range_decimation"],

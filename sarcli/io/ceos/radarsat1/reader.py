@@ -38,7 +38,7 @@ import numpy as np
 
 from orbit.frames import gmst
 from orbit.timeutil import format_utc
-from sarcli.errors import FormatError
+from sarcli.errors import FormatError, MissingFileError
 from sarcli.io.ceos.radarsat1 import aux as A
 from sarcli.io.ceos.radarsat1.datafile import ECHO_START, index_records
 from sarcli.io.ceos.radarsat1.leader import parse_leader
@@ -60,7 +60,7 @@ def find_scene_files(path: str | os.PathLike, data: str | os.PathLike | None = N
     if data is not None:
         for p in (path, Path(data)):
             if not p.is_file():
-                raise FormatError(f"{p}: no such file")
+                raise MissingFileError(f"{p}: no such file")
         return path, Path(data)
     if not path.is_dir():
         raise FormatError(f"{path}: give a leader and a data file, or a CEOS scene folder")
