@@ -48,6 +48,8 @@ SKIP: list[tuple[str, str]] = [
     (r"ati montecarlo|orbit accuracy|--algorithm backprojection",
      "minutes of computation (bench/; tests/ati, tests/orbit, tests/focus test the same code on small inputs)"),
     (r"--format s1-l0", "7-17 s of simulation (tests/sentinel1/test_simulate_l0.py)"),
+    (r"--device cuda", "needs a CUDA GPU and the gpu extra (tests/gpu runs the same code under numba's CUDA "
+                       "simulator)"),
     (r"interfere t\d\.h5 t\d\.h5", "focuses two outdoor scans first: 15-25 s each alone, minutes on a shared CI "
                                    "machine (README's `gbsar interfere t1_img.h5 t2_img.h5` runs; "
                                    "tests/gbsar/test_interferometry.py)"),
