@@ -109,7 +109,8 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
     with base.using(provenance):
         output = Path(config.output)
         written = [output / name for name in SCENE_FILES] if config.format == "ceos" else [output]
-        base.refuse_overwriting_inputs([config.scene], [output] + (written if config.format == "ceos" else []))
+        base.refuse_overwriting_inputs([config.scene], [output] + (written if config.format == "ceos" else []),
+                                       folders=[output] if config.format == "ceos" else [])
         if not output.resolve().parent.is_dir():
             raise ConfigError(f"output folder {output.resolve().parent} does not exist: create it first")
         if output.is_dir() and config.format != "ceos":

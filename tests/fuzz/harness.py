@@ -116,6 +116,8 @@ class DataEdit:
                 a = a.flat[0] if a.size else np.float64(0.0)
             elif op == "scale" and a.dtype.kind in "fc":
                 a = a * self.factor
+            elif op == "add" and a.dtype.kind in "fc":
+                a = a + self.factor
             elif op == "to_int" and a.dtype.kind in "fc":
                 a = np.real(a).astype(np.int32) if np.all(np.isfinite(np.real(a))) else np.zeros(a.shape, np.int32)
             elif op == "to_str" and a.dtype.names is None:
@@ -178,7 +180,30 @@ class ByteEdit:
         p.write_bytes(bytes(data))
 
 
-Corruption = AttrEdit | DataEdit | GroupEdit | ByteEdit
+@dataclasses.dataclass(frozen=True)
+class TextEdit:
+    """Replace the text ``old`` (which must occur) by ``new`` in the text file ``file`` (a scene file)."""
+
+    file: str
+    old: str
+    new: str
+
+    def apply(self, root: Path, target: str) -> None:
+        p = root / self.file
+        text = p.read_text()
+        assert self.old in text, f"{self.file} has no {self.old!r}"
+        p.write_text(text.replace(self.old, self.new))
+
+
+@dataclasses.dataclass(frozen=True)
+class NoEdit:
+    """The pristine product itself (a case whose hostile part is the command line)."""
+
+    def apply(self, root: Path, target: str) -> None:
+        return None
+
+
+Corruption = AttrEdit | DataEdit | GroupEdit | ByteEdit | TextEdit | NoEdit
 
 
 @dataclasses.dataclass(frozen=True)
