@@ -16,6 +16,7 @@ import numpy as np
 
 from sarcli.errors import ProductError
 from sarcli.model import checks as ck
+from sarcli.model import plausible
 from sarcli.model.constants import C_LIGHT
 
 # Plausibility bounds of a raw product (SI). A value outside them is a damaged or mislabelled product,
@@ -59,7 +60,7 @@ class Radar:
         """Refuse (one :class:`ProductError` line) a missing, mistyped or physically implausible parameter.
 
         Checks: every parameter a finite number; PRF, sampling rate and carrier within the module's bounds;
-        wavelength = c / carrier to 0.1 %; a non-zero chirp rate whose band |K| tau fits in the complex
+        wavelength = c / carrier to 0.1 %; a chirp of time-bandwidth product >= 1 whose band |K| tau fits in the complex
         sampling rate; pulse and receive window (``n_samples`` / fs, when known) within one pulse interval
         (a monostatic radar cannot receive while it transmits); first_range_m = c window_start_s / 2.
         """
@@ -79,6 +80,7 @@ class Radar:
         if tau + window >= 1.0 / prf:
             raise ProductError(f"{w}: pulse ({tau * 1e6:.6g} us) plus receive window ({window * 1e6:.6g} us) "
                                f"exceed the pulse interval 1/PRF = {1e6 / prf:.6g} us")
+        plausible.chirp(w, k, tau)
         if abs(k) * tau > fs * (1.0 + 1e-9):
             raise ProductError(f"{w}: chirp band |K| tau = {abs(k) * tau / 1e6:.6g} MHz exceeds the sampling "
                                f"rate {fs / 1e6:.6g} MHz (the samples would alias)")

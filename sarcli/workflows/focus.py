@@ -165,8 +165,11 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
     """(model, how): from the Doppler product, from (fdc, fr), or estimated from the data."""
     if config.doppler is not None:
         from sarcli.io.doppler_product import read_doppler
+        from sarcli.model.plausible import doppler_model
 
-        return read_doppler(config.doppler), f"read from {Path(config.doppler).name}"
+        model = read_doppler(config.doppler)
+        doppler_model(str(config.doppler), model, raw, shape)  # against the geometry before use (issue 29)
+        return model, f"read from {Path(config.doppler).name}"
     if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT
         from sarcli.model.doppler import GeometricDoppler

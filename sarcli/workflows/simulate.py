@@ -121,6 +121,11 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
             sc.seed = config.seed
         if config.format == "ceos":
             check_ceos_scene(sc)
+        from sarcli.memory import fits_in_memory
+
+        channels = 2 if "second_channel" in sc.effects else 1  # the echo and a complex128 working copy of it
+        fits_in_memory(f"simulating {sc.radar.n_lines} x {sc.radar.n_samples} samples",
+                       channels * sc.radar.n_lines * sc.radar.n_samples * (8.0 + 16.0))
         total = sc.radar.n_lines * (2 if sc.clutter and sc.clutter_model == "binned" else 1)
         done = 0
 

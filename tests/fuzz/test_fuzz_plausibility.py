@@ -26,7 +26,7 @@ REFUSED = [
     ("scene-n-lines-1e8", "rs1_toml", TextEdit("tiny_rs1.toml", "n_lines = 256", "n_lines = 100000000"),
      ("simulate", "{IN}", "-o", "{OUT}"), "memory"),
     ("scene-n-samples-2e9", "rs1_toml", TextEdit("tiny_rs1.toml", "n_samples = 162", "n_samples = 2000000000"),
-     ("simulate", "{IN}", "-o", "{OUT}"), "n_samples"),
+     ("simulate", "{IN}", "-o", "{OUT}"), "receive window"),
     ("scene-seed-overflow", "rs1_toml", TextEdit("tiny_rs1.toml", "seed = 20020616", "seed = 99999999999999999999"),
      ("simulate", "{IN}", "-o", "{OUT}"), "seed"),
     ("scene-snr-1e308", "rs1_toml", TextEdit("tiny_rs1.toml", "snr_db = 10.0", "snr_db = 1e308"),
