@@ -70,16 +70,17 @@ class PlaneGrid:
             raise ConfigError(f"--grid needs six or seven finite numbers x0,x1,dx,y0,y1,dy[,z] (m), got "
                               f"{','.join(f'{v:g}' for v in spec) or 'nothing'}")
         x0, x1, dx, y0, y1, dy = spec[:6]
-        axes = []
+        sizes = []
         for name, a, b, d in (("x", x0, x1, dx), ("y", y0, y1, dy)):
             if not d > 0 or b < a:
                 raise ConfigError(f"--grid: {name} runs from {a:g} to {b:g} m in steps of {d:g} m; the step must "
                                   f"be > 0 and the end >= the start")
-            axes.append(a + d * np.arange(math.floor((b - a) / d + 1e-9) + 1))
-        if axes[0].size * axes[1].size > MAX_GRID_PIXELS:
-            raise ConfigError(f"--grid has {axes[1].size} x {axes[0].size} pixels (more than {MAX_GRID_PIXELS:.0e}): "
+            sizes.append(math.floor((b - a) / d + 1e-9) + 1)
+        if sizes[0] * sizes[1] > MAX_GRID_PIXELS:  # before the axes are allocated (1 mm over 2000 km: 16 GB each)
+            raise ConfigError(f"--grid has {sizes[1]:.4g} x {sizes[0]:.4g} pixels (more than {MAX_GRID_PIXELS:.0e}): "
                               "use larger steps or a smaller area")
-        return cls(xs=axes[0], ys=axes[1], z=float(spec[6]) if len(spec) == 7 else 0.0)
+        xs, ys = (a + d * np.arange(n) for (a, d), n in zip(((x0, dx), (y0, dy)), sizes, strict=True))
+        return cls(xs=xs, ys=ys, z=float(spec[6]) if len(spec) == 7 else 0.0)
 
 
 def _positive(name: str, flag: str, value: float | None, what: str) -> None:

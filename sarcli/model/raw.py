@@ -36,6 +36,7 @@ EARTH_MU = 3.986004418e14  # m^3/s^2, WGS-84 GM
 EARTH_OMEGA = 7.2921151467e-5  # rad/s, WGS-84 rotation rate
 EARTH_POLAR_RADIUS_M = 6.356752e6  # WGS-84 b: an osculating perigee below it is a trajectory into the ground
 ORBIT_CHORD_RTOL = 0.1  # (p[k+1] - p[k]) / dt agrees with the mean velocity (when the arc is < 0.5 rad)
+MAX_SQUINT_RAD = np.radians(45.0)  # |pitch|, |yaw| of a side-looking SAR's flight frame (stripmap squints)
 ORBIT_FRAMES = ("ECI", "ECEF", "LOCAL")
 LOOK_SIDES = ("right", "left")
 
@@ -171,7 +172,8 @@ class Attitude:
     yaw: np.ndarray
 
     def validate(self, where: str = "attitude") -> None:
-        """Strictly increasing finite times; one finite angle per time for pitch, roll and yaw, |angle| <= pi."""
+        """Strictly increasing finite times; one finite angle per time for pitch, roll and yaw, |angle| <= pi;
+        |pitch|, |yaw| <= 45 degrees (:data:`MAX_SQUINT_RAD`)."""
         w = f"{where}: attitude"
         t = ck.array(w, "time", self.time, "f", ndim=1, min_size=1)
         ck.increasing(w, "time", t)
@@ -179,6 +181,10 @@ class Attitude:
             a = ck.array(w, name, getattr(self, name), "f", shape=(t.shape[0],))
             if np.any(np.abs(a) > np.pi):
                 raise ProductError(f"{w}: {name} exceeds pi rad in magnitude (angles are in radians)")
+            if name != "roll" and np.any(np.abs(a) > MAX_SQUINT_RAD):  # roll sets the look angle: any
+                raise ProductError(f"{w}: {name} reaches {np.degrees(np.abs(a).max()):.1f} degrees: a side-looking "
+                                   f"beam within {np.degrees(MAX_SQUINT_RAD):.0f} degrees of broadside cannot have it "
+                                   "(a yaw turned by 180 degrees? the attitude would predict the wrong Doppler)")
 
 
 @dataclass
