@@ -195,7 +195,9 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
     """Rows: compression bins in [min_range, max_range]; columns: k*dx lattice over ``width``.
 
     Default width ``min(lam R/(2 dx), lam R/L_x + X)`` at the top range R (DF's azimuth width, or the
-    beam footprint plus the rail); default pixel ``k dx`` with ``k = round(dR/(2 dx))`` (>= 1).
+    beam footprint plus the rail); for backprojection ``lam R/L_x + X`` (the whole track plus the beam
+    footprint: DF's FFT width is no limit of BP's, issue 29); default pixel ``k dx`` with
+    ``k = round(dR/(2 dx))`` (>= 1).
     """
     r = prof.ranges_m
     keep = (r >= opts.min_range_m) & (r <= (opts.max_range_m if opts.max_range_m is not None else np.inf))
@@ -207,7 +209,9 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
     lam = prof.wavelength_m
     rail = float(x[-1] - x[0])
     rt = float(ranges[-1])
-    width = opts.width_m if opts.width_m is not None else min(lam * rt / (2 * dx), lam * rt / antenna_length_m + rail)
+    footprint = lam * rt / antenna_length_m + rail
+    width = (opts.width_m if opts.width_m is not None else footprint if opts.algorithm == "bp"
+             else min(lam * rt / (2 * dx), footprint))
     k = max(1, int(round((opts.pixel_x_m if opts.pixel_x_m is not None else prof.dr_m / 2) / dx)))
     if opts.pixel_x_m is not None and not math.isclose(k * dx, opts.pixel_x_m, rel_tol=1e-6):
         raise SarcliError(f"--pixel-x must be a multiple of the rail step {dx:g} m")
