@@ -191,6 +191,11 @@ def _refuse_unresolved(model, config: Config) -> None:
         raise ProductError("the Doppler centroid's PRF ambiguity is unresolved (the model may be whole PRFs off): "
                            "give the centroid with --fdc/--fr, resolve it in 'sarcli doppler' (an orbit, "
                            "--ambiguity), or accept it with --accept-unresolved-ambiguity")
+    from sarcli.model.doppler_summary import low_confidence_note
+
+    note = None if config.accept_unresolved_ambiguity else low_confidence_note(getattr(model, "summary", None))
+    if note:
+        log.warning(note)
 
 
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> FocusReport:
