@@ -196,7 +196,7 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
 
     Default width ``min(lam R/(2 dx), lam R/L_x + X)`` at the top range R (DF's azimuth width, or the
     beam footprint plus the rail); for backprojection ``lam R/L_x + X`` (the whole track plus the beam
-    footprint: DF's FFT width is no limit of BP's, issue 29); default pixel ``k dx`` with
+    footprint: DF's FFT width is no limit of BP's); default pixel ``k dx`` with
     ``k = round(dR/(2 dx))`` (>= 1).
     """
     r = prof.ranges_m

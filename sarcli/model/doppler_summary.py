@@ -58,7 +58,7 @@ def _floats(v: Any) -> np.ndarray:
 
 
 #: below this ambiguity confidence (the probability that the ambiguity's rounding is right) a resolved
-#: ambiguity is used only with a warning saying how confident and what to do (docs/doppler.md; issue 29)
+#: ambiguity is used only with a warning saying how confident and what to do (docs/doppler.md)
 AMBIGUITY_CONFIDENCE_LEVEL = 0.9
 
 

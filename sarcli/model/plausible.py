@@ -3,9 +3,11 @@ readers, the simulator and the focusing inputs share (one :class:`ProductError` 
 number and the bound it breaks). docs/products.md, "What sarcli refuses", lists them.
 
 - a chirp: rate K (Hz/s, signed) and pulse length tau (s) with a time-bandwidth product |K| tau^2 of at
-  least :data:`MIN_TIME_BANDWIDTH` (below 1 the "chirp" sweeps less than the 1/tau spectrum of its own
-  pulse envelope: no pulse compression, a damaged or mis-scaled rate) and a band |K| tau within the
-  complex sampling rate (:meth:`sarcli.model.raw.Radar.validate`);
+  least :data:`MIN_TIME_BANDWIDTH` = 0.01: the swept band |K| tau is then at least 1 % of the 1/tau
+  spectrum of the pulse envelope itself. SAR chirps have 100 to 2000 (Radarsat-1: 1256), short test
+  pulses about 1; a hundredth is a rate given in the wrong unit (Hz/us for Hz/s: a factor 1e6) or damaged
+  (a MATLAB ``Kr = -1``: 1.7e-9). The band must also fit the complex sampling rate
+  (:meth:`sarcli.model.raw.Radar.validate`);
 - valid-sample windows [start, stop) of a record of n samples: 0 <= start < stop and start < n (a window
   beyond the record would leave a line without one sample);
 - a Doppler model against the geometry (:func:`doppler_model`): the rate of a side-looking radar of
@@ -26,7 +28,7 @@ import numpy as np
 
 from sarcli.errors import ProductError
 
-MIN_TIME_BANDWIDTH = 1.0  # |K| tau^2 of the shortest chirp a SAR compresses
+MIN_TIME_BANDWIDTH = 0.01  # |K| tau^2: a band of 1 % of the pulse's own 1/tau spectrum (module docstring)
 FR_FACTOR = 3.0  # |fr| within [1/3, 3] x 2 V^2 / (lam R): effective velocity and squint < 55 deg
 FDC_BLOCK_TOLERANCE_PRF = 0.25  # the centroid model at its blocks: within a quarter PRF of their estimates
 MAX_SPEED_MPS = 1.2e4  # the fastest platform sarcli accepts (sarcli.model.raw.SPEED_MPS)
@@ -37,8 +39,8 @@ def chirp(where: str, rate_hz_per_s: float, pulse_s: float) -> None:
     tbp = abs(rate_hz_per_s) * pulse_s**2
     if not tbp >= MIN_TIME_BANDWIDTH:
         raise ProductError(f"{where}: chirp rate {rate_hz_per_s:g} Hz/s over a {pulse_s * 1e6:.6g} us pulse is "
-                           f"implausible: time-bandwidth product |K| tau^2 = {tbp:.3g} < {MIN_TIME_BANDWIDTH:g} (no "
-                           "pulse compression; a mis-scaled or damaged rate?)")
+                           f"implausible: time-bandwidth product |K| tau^2 = {tbp:.3g} < {MIN_TIME_BANDWIDTH:g} (a "
+                           "rate in the wrong unit, or damaged?)")
 
 
 def sample_windows(where: str, name: str, windows: np.ndarray, n_samples: int) -> np.ndarray:

@@ -61,8 +61,9 @@ class Radar:
         """Refuse (one :class:`ProductError` line) a missing, mistyped or physically implausible parameter.
 
         Checks: every parameter a finite number; PRF, sampling rate and carrier within the module's bounds;
-        wavelength = c / carrier to 0.1 %; a chirp of time-bandwidth product >= 1 whose band |K| tau fits in the complex
-        sampling rate; pulse and receive window (``n_samples`` / fs, when known) within one pulse interval
+        wavelength = c / carrier to 0.1 %; a chirp of time-bandwidth product >= 0.01 whose band |K| tau fits
+        in the complex sampling rate; pulse and receive window (``n_samples`` / fs, when known) within one
+        pulse interval
         (a monostatic radar cannot receive while it transmits); first_range_m = c window_start_s / 2.
         """
         w = f"{where}: radar"

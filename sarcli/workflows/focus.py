@@ -168,7 +168,7 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
         from sarcli.model.plausible import doppler_model
 
         model = read_doppler(config.doppler)
-        doppler_model(str(config.doppler), model, raw, shape)  # against the geometry before use (issue 29)
+        doppler_model(str(config.doppler), model, raw, shape)  # against the geometry, before use
         return model, f"read from {Path(config.doppler).name}"
     if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT

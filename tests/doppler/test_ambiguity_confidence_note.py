@@ -1,4 +1,4 @@
-"""Issue 29 #13: a resolved ambiguity of confidence below AMBIGUITY_CONFIDENCE_LEVEL (0.90) is used with a
+"""A resolved ambiguity of confidence below AMBIGUITY_CONFIDENCE_LEVEL (0.90) is used with a
 warning that gives the confidence and what the user can do; none at or above it, none when unresolved
 (focus refuses those), and focus prints it."""
 

@@ -1,4 +1,4 @@
-"""Issue 29 (items 21-23), kept as regressions: inputs whose every number has the right type but no
+"""Hostile inputs found by hand, kept as regressions: inputs whose every number has the right type but no
 physical meaning (absurd sizes, overflowing seeds, a rail of 4000 km, a Doppler model that contradicts
 the geometry, valid-sample windows outside the record, a chirp of -1 Hz/s), which the commands took
 with a traceback or, worse, exit 0 and a wrong product. Each case here is refused in one line

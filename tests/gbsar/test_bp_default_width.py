@@ -1,4 +1,4 @@
-"""Issue 29 #15: backprojection's default image width is the whole track plus the beam footprint at the
+"""Backprojection's default image width is the whole track plus the beam footprint at the
 top range, X + lam R / L_x; DF's azimuth width lam R / (2 dx) (its FFT's unambiguous width) is no bound
 of BP's and caps only DF, RD and auto."""
 
