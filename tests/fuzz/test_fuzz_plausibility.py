@@ -13,7 +13,7 @@ import math
 import pytest
 
 from tests.conftest import run_cli
-from tests.fuzz.harness import AttrEdit, DataEdit, NoEdit, TextEdit, check_output, run_case
+from tests.fuzz.harness import FDC_FR, AttrEdit, DataEdit, NoEdit, TextEdit, check_output, run_case
 
 WALL = ("[[walls]]\nstart_m = [-1.0, 5.0, 1.5]\nend_m = [1.0, 5.0, 1.5]\nspacing_m = 1e-9\nscattering = 1.0\n\n"
         "[effects.noise]")
@@ -51,6 +51,9 @@ REFUSED = [
      ("gbsar", "simulate", "{IN}", "-o", "{OUT}"), "power_db"),
     ("gbsar-rail-4000-km", "scan", DataEdit("/rail_position", "scale", factor=1e6),
      ("gbsar", "focus", "{IN}", "-o", "{OUT}"), "rail"),
+    # 11: a GeoTIFF with no valid pixel (the tiny scene's 256 lines are shorter than its 708-line aperture)
+    ("geotiff-no-full-line", "raw", NoEdit(), ("focus", "{IN}", *FDC_FR, "-o", "{OUT}", "--geotiff", "{OUT_TIF}"),
+     "longer than the scene"),
 ]
 
 
@@ -167,3 +170,19 @@ def test_output_that_is_a_folder_is_refused_without_leftovers(pristine, tmp_path
     assert r.exit_code == 2 and r.stderr.count("sarcli: error:") == 1, r.stderr
     assert "folder" in r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["adir"] and not any(folder.iterdir())
+
+
+def test_geotiff_tag_of_an_slc_without_a_fully_focused_line():
+    """The tag said "3644..999" for the ALOS cut (first 3644, last -2645: the -1 "no span recorded"
+    default of the model was read into every negative last line); now the recorded span, or none."""
+    import numpy as np
+
+    from sarcli.focus.geocode import full_span
+
+    class S:
+        azimuth_time = np.zeros(1000)
+
+    for first, last, want in ((3644, -2645, (3644, -2645)), (0, -1, (0, 999)), (10, 989, (10, 989))):
+        s = S()
+        s.first_full_line, s.last_full_line = first, last
+        assert full_span(s) == want
