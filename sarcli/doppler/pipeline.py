@@ -272,6 +272,8 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
         elif res.resolved and compress:
             resolved = _orbit_agrees_with_data(run_data_only, data_only, fbb_scene + res.n0 * prf,
                                                options.orbit_sigma_hz, prf)
+            if resolved:  # a check only: the summary keeps the data-only estimates where they decided or disagree
+                data_only.clear()
     elif mode == "data":
         n_d, conf = run_data_only()
         res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, tol)
