@@ -63,7 +63,7 @@ from sarcli.errors import ConfigError, SarcliError
 from sarcli.io.scan import POLARIZATIONS
 from sarcli.memory import fits_in_memory
 from sarcli.model.constants import C_LIGHT
-from sarcli.model.gbsar import Antenna, Site
+from sarcli.model.gbsar import RAIL_SPAN_M, Antenna, Site
 
 KIND_POINT, KIND_WALL, KIND_CLUTTER, KIND_ZONE = 0, 1, 2, 3
 
@@ -234,6 +234,11 @@ class RailSection:
                 raise ConfigError("[rail] needs length_m and step_m, or positions_m")
             if not (self.step_m > 0 and self.length_m >= 0):
                 raise ConfigError("[rail] needs step_m > 0 and length_m >= 0")
+            if not self.length_m <= RAIL_SPAN_M:  # the scan it makes would be refused (sarcli.model.gbsar)
+                raise ConfigError(f"[rail] length_m = {self.length_m:g} m: a ground-based rail is at most "
+                                  f"{RAIL_SPAN_M:g} m long")
+            n_stops = self.length_m / self.step_m + 1
+            fits_in_memory(f"[rail] {n_stops:.4g} stops", n_stops * 64.0)  # positions, heights, times, S21 rows
             n = int(round(self.length_m / self.step_m)) + 1  # N_x = X/dx + 1 (Table 1 prints "- 1", a typo)
             pos = (np.arange(n) - (n - 1) / 2) * self.step_m
         if pos.size < 1 or not np.all(np.isfinite(pos)):
