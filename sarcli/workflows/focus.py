@@ -193,7 +193,8 @@ def _refuse_unresolved(model, config: Config) -> None:
                            "--ambiguity), or accept it with --accept-unresolved-ambiguity")
     from sarcli.model.doppler_summary import low_confidence_note
 
-    note = None if config.accept_unresolved_ambiguity else low_confidence_note(getattr(model, "summary", None))
+    note = (None if config.accept_unresolved_ambiguity or config.doppler is None  # an estimate here has warned
+            else low_confidence_note(getattr(model, "summary", None)))
     if note:
         log.warning(note)
 
