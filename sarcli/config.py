@@ -102,6 +102,8 @@ def _coerce(value: Any, tp: Any, where: str) -> Any:
         if isinstance(value, bool) or not isinstance(value, int | float) or (
                 isinstance(value, float) and not (math.isfinite(value) and value.is_integer())):
             raise ConfigError(f"{where}: expected an integer, got {value!r}")
+        if not -(2**63) <= int(value) < 2**63:  # seeds, counts: stored as int64 (numpy, HDF5)
+            raise ConfigError(f"{where}: {int(value)} does not fit a 64-bit integer")
         return int(value)
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, int | float):

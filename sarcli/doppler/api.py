@@ -15,12 +15,14 @@ from sarcli.config import to_mapping
 from sarcli.doppler import inputs, pipeline
 from sarcli.doppler.options import DopplerOptions
 from sarcli.model.doppler import PolyDoppler
+from sarcli.model.doppler_summary import low_confidence_note
 from sarcli.model.raw import RawProduct
 from sarcli.model.terrain import ConstantHeight, Terrain
 
 _UNRESOLVED = {
     "none": "no orbit, and the swath is not longer than the pulse for the data-only estimate",
-    "orbit": "the orbit prediction is half-way between two ambiguities and the data could not decide",
+    "orbit": "the orbit prediction is half-way between two ambiguities and the data could not decide, or the "
+             "orbit/attitude and the data disagree",
     "data": "the data-only estimate found no usable range block",
 }
 
@@ -48,4 +50,6 @@ def estimate_doppler(raw: RawProduct, options: DopplerOptions | None = None, *, 
         warnings.warn(f"Doppler ambiguity not resolved ({why}): fdc {s.fdc_hz:.1f} Hz "
                       f"assumes ambiguity {s.ambiguity}; give it with --ambiguity-value N, or use a product with an "
                       "orbit", stacklevel=2)
+    elif (note := low_confidence_note(s)) is not None:
+        warnings.warn(note, stacklevel=2)
     return model

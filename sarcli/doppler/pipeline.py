@@ -189,6 +189,35 @@ def scene_geometry(raw: RawProduct, options: DopplerOptions, terrain: Terrain, b
 
 # --- stage 3 ---------------------------------------------------------------------------------------
 
+#: the orbit/attitude centroid and the data-only one disagree when they differ by more than this many
+#: standard errors (both errors combined): the prediction is then not trusted to resolve the ambiguity
+DISAGREE_SIGMAS = 3.0
+
+
+def _orbit_agrees_with_data(run_data_only: Callable[[], tuple[int, float]], data_only: list[DataOnlyEstimate],
+                            fdc_orbit_hz: float, orbit_sigma_hz: float, prf: float) -> bool:
+    """Cross-check an orbit-resolved scene centroid ``fdc_orbit_hz`` against the data-only estimate
+    (MLCC + MLBF combined, run here): False, with a warning saying both, when they differ by more than
+    :data:`DISAGREE_SIGMAS` combined standard errors (a wrong attitude, e.g. a yaw off by 180 degrees,
+    predicts a centroid whole PRFs away from the echo's) and by at least half a PRF."""
+    import logging
+
+    run_data_only()
+    best = next((e for e in data_only if e.method == "combined"), None)
+    if best is None or not (np.isfinite(best.fdc_hz) and np.isfinite(best.sigma_hz)):
+        return True
+    gap = abs(best.fdc_hz - fdc_orbit_hz)
+    bound = DISAGREE_SIGMAS * float(np.hypot(orbit_sigma_hz, best.sigma_hz))
+    if gap <= bound or gap < 0.5 * prf:  # within their errors, or the same ambiguity
+        return True
+    logging.getLogger(__name__).warning(
+        "the orbit/attitude predict a centroid of %.0f Hz, the echo (data-only %s) %.0f +- %.0f Hz: they disagree "
+        "by %.0f Hz (more than %.0f sigma): the PRF ambiguity is NOT resolved; check the attitude, or decide it "
+        "with --ambiguity data or --ambiguity-value N", fdc_orbit_hz, best.method, best.fdc_hz, best.sigma_hz, gap,
+        DISAGREE_SIGMAS)
+    return False
+
+
 def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBlocks, fu: np.ndarray,
                       geo: SceneGeometry | None) -> AmbiguityStage:
     """Stage 3: one ambiguity for the scene (module docstring), per-block ambiguities and absolute
@@ -240,6 +269,11 @@ def resolve_ambiguity(raw: RawProduct, options: DopplerOptions, bb: BasebandBloc
                 res_d = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, tol)
                 res = dataclasses.replace(res_d, margin=res.margin, offset_prf=res.offset_prf, resolved=False)
                 source, conf, resolved = "orbit+data", c_d, True
+        elif res.resolved and compress:
+            resolved = _orbit_agrees_with_data(run_data_only, data_only, fbb_scene + res.n0 * prf,
+                                               options.orbit_sigma_hz, prf)
+            if resolved:  # a check only: the summary keeps the data-only estimates where they decided or disagree
+                data_only.clear()
     elif mode == "data":
         n_d, conf = run_data_only()
         res = amb.resolve(fbb, fu, fbb_scene + n_d * prf, w, prf, tol)

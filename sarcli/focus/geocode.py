@@ -53,7 +53,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from sarcli.errors import SarcliError
+from sarcli.errors import ProductError, SarcliError
 from sarcli.model.slc import SLC
 from sarcli.model.terrain import ConstantHeight, Terrain
 
@@ -99,24 +99,41 @@ def _multilook(image: np.ndarray, la: int, lr: int) -> np.ndarray:
     return out
 
 
+def full_span(slc: SLC) -> tuple[int, int]:
+    """(first, last) fully focused line: the recorded span (``last < first``: none), or every line when the
+    product records none (the model's default 0, -1)."""
+    if slc.first_full_line == 0 and slc.last_full_line < 0:
+        return 0, slc.azimuth_time.size - 1
+    return slc.first_full_line, slc.last_full_line
+
+
 def full_rows(slc: SLC, n_rows: int, looks_az: int) -> np.ndarray:
-    """Per multilooked row, whether all its ``looks_az`` lines are fully focused (first_full_line ..
-    last_full_line; a product that records no span counts as fully focused)."""
-    last = slc.last_full_line if slc.last_full_line >= 0 else slc.azimuth_time.size - 1
+    """Per multilooked row, whether all its ``looks_az`` lines are fully focused (:func:`full_span`).
+    None is: the image would hold no valid pixel, refused in one line that says why."""
+    first, last = full_span(slc)
     lines = np.arange(n_rows) * looks_az
-    return (lines >= slc.first_full_line) & (lines + looks_az - 1 <= last)
+    full = (lines >= first) & (lines + looks_az - 1 <= last)
+    if not full.any():
+        n = slc.azimuth_time.size
+        why = (f"the synthetic aperture (about {2 * first} lines) is longer than the scene's {n} lines, so no line "
+               f"is fully focused (first {first} > last {last})" if last < first else
+               f"the fully focused lines {first}..{last} hold no whole multilook of {looks_az} lines")
+        raise ProductError(f"an image of this SLC would hold no valid pixel: {why}; focus a longer scene, or leave "
+                           "out the GeoTIFF")
+    return full
 
 
 def slc_tags(slc: SLC, inputs: tuple = (), extra: dict | None = None) -> dict[str, str]:
     """The GeoTIFF provenance tags of an image made from ``slc`` (:func:`sarcli.io.images.provenance_tags`)."""
     from sarcli.io.images import provenance_tags
 
-    last = slc.last_full_line if slc.last_full_line >= 0 else slc.azimuth_time.size - 1
+    first, last = full_span(slc)
     return provenance_tags(
         inputs, sensor=slc.source, wavelength_m=slc.radar.wavelength_m, look_side=slc.look_side,
         acquisition=(slc.epoch_utc, float(slc.azimuth_time[0]), float(slc.azimuth_time[-1])),
         LINE_TIME="zero-Doppler", ALGORITHM=slc.algorithm,
-        FULLY_FOCUSED_LINES=f"{slc.first_full_line}..{last} of {slc.azimuth_time.size} (others masked: nodata)",
+        FULLY_FOCUSED_LINES=(f"{first}..{last} of {slc.azimuth_time.size} (others masked: nodata)" if last >= first
+                             else f"none of {slc.azimuth_time.size} (all masked: nodata)"),
         **(extra or {}))
 
 

@@ -204,7 +204,9 @@ def _coverage_warnings(doppler, r: np.ndarray, t: np.ndarray) -> list[str]:
     """Warn when the scene reaches beyond the blocks the Doppler model was estimated on.
 
     A block covers half the spacing of the block centres either side (a single block: the whole
-    scene); beyond that the model is extrapolated.
+    scene), and the fit also the partial block an estimator leaves at each edge (less than one block
+    spacing: a smooth polynomial carried that far is not an extrapolation worth a warning, and the
+    model estimated on this very scene always stops there); beyond that the model is extrapolated.
     """
     blocks = getattr(doppler, "blocks", None)
     out = []
@@ -215,7 +217,7 @@ def _coverage_warnings(doppler, r: np.ndarray, t: np.ndarray) -> list[str]:
         c = np.unique(np.asarray(centres, float))
         if c.size == 0:
             continue
-        half = 0.5 * float(np.median(np.diff(c))) if c.size > 1 else 0.5 * float(np.ptp(axis))
+        half = 1.5 * float(np.median(np.diff(c))) if c.size > 1 else 0.5 * float(np.ptp(axis))
         half *= 1.01
         lo, hi = c.min() - half, c.max() + half
         if axis[0] < lo or axis[-1] > hi:

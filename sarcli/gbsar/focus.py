@@ -74,16 +74,17 @@ class PlaneGrid:
             raise ConfigError(f"--grid needs six or seven finite numbers x0,x1,dx,y0,y1,dy[,z] (m), got "
                               f"{','.join(f'{v:g}' for v in spec) or 'nothing'}")
         x0, x1, dx, y0, y1, dy = spec[:6]
-        axes = []
+        sizes = []
         for name, a, b, d in (("x", x0, x1, dx), ("y", y0, y1, dy)):
             if not d > 0 or b < a:
                 raise ConfigError(f"--grid: {name} runs from {a:g} to {b:g} m in steps of {d:g} m; the step must "
                                   f"be > 0 and the end >= the start")
-            axes.append(a + d * np.arange(math.floor((b - a) / d + 1e-9) + 1))
-        if axes[0].size * axes[1].size > MAX_GRID_PIXELS:
-            raise ConfigError(f"--grid has {axes[1].size} x {axes[0].size} pixels (more than {MAX_GRID_PIXELS:.0e}): "
+            sizes.append(math.floor((b - a) / d + 1e-9) + 1)
+        if sizes[0] * sizes[1] > MAX_GRID_PIXELS:  # before the axes are allocated (1 mm over 2000 km: 16 GB each)
+            raise ConfigError(f"--grid has {sizes[1]:.4g} x {sizes[0]:.4g} pixels (more than {MAX_GRID_PIXELS:.0e}): "
                               "use larger steps or a smaller area")
-        return cls(xs=axes[0], ys=axes[1], z=float(spec[6]) if len(spec) == 7 else 0.0)
+        xs, ys = (a + d * np.arange(n) for (a, d), n in zip(((x0, dx), (y0, dy)), sizes, strict=True))
+        return cls(xs=xs, ys=ys, z=float(spec[6]) if len(spec) == 7 else 0.0)
 
 
 def _positive(name: str, flag: str, value: float | None, what: str) -> None:
@@ -213,7 +214,9 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
     """Rows: compression bins in [min_range, max_range]; columns: k*dx lattice over ``width``.
 
     Default width ``min(lam R/(2 dx), lam R/L_x + X)`` at the top range R (DF's azimuth width, or the
-    beam footprint plus the rail); default pixel ``k dx`` with ``k = round(dR/(2 dx))`` (>= 1).
+    beam footprint plus the rail); for backprojection ``lam R/L_x + X`` (the whole track plus the beam
+    footprint: DF's FFT width is no limit of BP's); default pixel ``k dx`` with
+    ``k = round(dR/(2 dx))`` (>= 1).
     """
     r = prof.ranges_m
     keep = (r >= opts.min_range_m) & (r <= (opts.max_range_m if opts.max_range_m is not None else np.inf))
@@ -225,7 +228,9 @@ def default_grid(prof: RangeProfiles, antenna_length_m: float, opts: FocusOption
     lam = prof.wavelength_m
     rail = float(x[-1] - x[0])
     rt = float(ranges[-1])
-    width = opts.width_m if opts.width_m is not None else min(lam * rt / (2 * dx), lam * rt / antenna_length_m + rail)
+    footprint = lam * rt / antenna_length_m + rail
+    width = (opts.width_m if opts.width_m is not None else footprint if opts.algorithm == "bp"
+             else min(lam * rt / (2 * dx), footprint))
     k = max(1, int(round((opts.pixel_x_m if opts.pixel_x_m is not None else prof.dr_m / 2) / dx)))
     if opts.pixel_x_m is not None and not math.isclose(k * dx, opts.pixel_x_m, rel_tol=1e-6):
         raise SarcliError(f"--pixel-x must be a multiple of the rail step {dx:g} m")

@@ -61,8 +61,9 @@ import numpy as np
 from sarcli.config import from_mapping, load_toml
 from sarcli.errors import ConfigError, SarcliError
 from sarcli.io.scan import POLARIZATIONS
+from sarcli.memory import fits_in_memory
 from sarcli.model.constants import C_LIGHT
-from sarcli.model.gbsar import Antenna, Site
+from sarcli.model.gbsar import RAIL_SPAN_M, Antenna, Site
 
 KIND_POINT, KIND_WALL, KIND_CLUTTER, KIND_ZONE = 0, 1, 2, 3
 
@@ -233,6 +234,11 @@ class RailSection:
                 raise ConfigError("[rail] needs length_m and step_m, or positions_m")
             if not (self.step_m > 0 and self.length_m >= 0):
                 raise ConfigError("[rail] needs step_m > 0 and length_m >= 0")
+            if not self.length_m <= RAIL_SPAN_M:  # the scan it makes would be refused (sarcli.model.gbsar)
+                raise ConfigError(f"[rail] length_m = {self.length_m:g} m: a ground-based rail is at most "
+                                  f"{RAIL_SPAN_M:g} m long")
+            n_stops = self.length_m / self.step_m + 1
+            fits_in_memory(f"[rail] {n_stops:.4g} stops", n_stops * 64.0)  # positions, heights, times, S21 rows
             n = int(round(self.length_m / self.step_m)) + 1  # N_x = X/dx + 1 (Table 1 prints "- 1", a typo)
             pos = (np.arange(n) - (n - 1) / 2) * self.step_m
         if pos.size < 1 or not np.all(np.isfinite(pos)):
@@ -437,6 +443,22 @@ class SceneFile:
     effects: EffectsSection = field(default_factory=EffectsSection)
 
 
+#: memory per realised scatterer (position, 4 complex reflectivities, kind, displacement, gains), bytes
+SCATTERER_BYTES = 256
+
+
+def _finite(v: Any, where: str) -> None:
+    """Refuse a NaN or infinite number anywhere in a scene table (``where``: its place in the file)."""
+    if isinstance(v, float) and not np.isfinite(v):
+        raise ConfigError(f"{where} = {v}: expected a finite number")
+    if isinstance(v, dict):
+        for k, x in v.items():
+            _finite(x, f"{where}.{k}" if where[-1] != "]" else f"{where} {k}")
+    elif isinstance(v, list):
+        for i, x in enumerate(v):
+            _finite(x, f"{where}[{i}]")
+
+
 _TABLES = {"scene": SceneSection, "sweep": SweepSection, "rail": RailSection, "antenna": AntennaSection,
            "site": Site, "processing": ProcessingSection, "clutter": ClutterSection, "effects": EffectsSection}
 _ARRAYS = {"points": PointEntry, "walls": WallEntry, "zones": ZoneEntry}
@@ -449,6 +471,7 @@ def parse_scene_file(doc: Any, source: str = "scene") -> SceneFile:
         raise ConfigError(f"{source}: a scene is a table of sections")
     parts: dict[str, Any] = {}
     for key, value in doc.items():
+        _finite(value, f"{source} [{key}]")
         try:
             if key in _TABLES:
                 parts[key] = from_mapping(_TABLES[key], value, f"{source} [{key}]")
@@ -515,7 +538,9 @@ def _targets(doc: SceneFile, lam: float, rail_h: float, source: str
         spacing = lam / 4 if w.spacing_m is None else w.spacing_m
         if not spacing > 0:
             raise ConfigError(f"{where}: spacing_m must be > 0")
-        n = max(int(np.ceil(np.linalg.norm(b - a) / spacing)) + 1, 2)
+        n_f = np.ceil(np.linalg.norm(b - a) / spacing) + 1
+        fits_in_memory(f"{where}: {n_f:.4g} scatterers (spacing_m = {spacing:g} m)", n_f * SCATTERER_BYTES)
+        n = max(int(n_f), 2)
         pos = a + (b - a) * np.linspace(0.0, 1.0, n)[:, None]
         refl = np.repeat(_scattering(w.scattering, where)[:, None], n, 1)
         out.append((pos, refl, KIND_WALL, w.stable, _displacement(w, 0.5 * (a + b), rail_h, where),

@@ -26,6 +26,7 @@ from numba import njit
 from sarcli.errors import SarcliError
 from sarcli.gbsar.scene import Scene
 from sarcli.io.scan import POLARIZATIONS
+from sarcli.memory import fits_in_memory
 from sarcli.model.constants import C_LIGHT
 from sarcli.model.gbsar import Scan
 
@@ -133,9 +134,11 @@ def simulate_stop(scene: Scene, position_m: float, height_m: float, frequency_hz
 
 def simulate(scene: Scene, progress=None) -> Scan:
     """Simulate a whole scan of ``scene`` (every planned stop); ``progress`` wraps the stop iterator."""
+    n = scene.positions_m.size
+    fits_in_memory(f"a scan of {len(scene.polarizations)} x {n} x {scene.points} samples",
+                   len(scene.polarizations) * n * scene.points * 8.0 + scene.points * 40.0)
     freq = scene.frequencies()
     heights = scene.rail_heights()
-    n = scene.positions_m.size
     s21 = np.empty((len(scene.polarizations), n, freq.size), np.complex64)
     stops = range(n) if progress is None else progress(range(n))
     for i in stops:

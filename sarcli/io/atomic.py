@@ -59,6 +59,8 @@ def atomic_path(path: str | os.PathLike, suffix: str = ".tmp") -> Iterator[str]:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise ProductError(f"output folder {folder} does not exist")
+    if path.is_dir():  # the rename would fail after all the work, leaving the temporary file
+        raise ProductError(f"output {path} is an existing folder: give a file name")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=folder)
     os.close(fd)
     try:

@@ -25,6 +25,7 @@ Layout (SI units)::
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 
@@ -149,6 +150,12 @@ def read_doppler(path: str | os.PathLike) -> PolyDoppler:
             if len({v.size for v in blocks.values()}) > 1:
                 raise ProductError(f"{path}: malformed doppler product, the block columns differ in length")
         summary = DopplerSummary.from_dict(attr_json(f, "summary_json", {}), f"{path}: summary_json")
+        if "ambiguity_resolved" in f.attrs:  # 0/1; where it and the summary differ, not resolved
+            v = f.attrs["ambiguity_resolved"]
+            flag = bool(v) if isinstance(v, bool | np.bool_) else attr_number(f, "ambiguity_resolved", lo=0, hi=1,
+                                                                                integer=True)
+            if summary.ambiguity_resolved and not flag:
+                summary = dataclasses.replace(summary, ambiguity_resolved=False)
         params = provenance(f).get("parameters") or {}
         return PolyDoppler(_read_poly(f, "fdc_poly", path), _read_poly(f, "fr_poly", path), prf, lam, blocks,
                             summary, params if isinstance(params, dict) else {})

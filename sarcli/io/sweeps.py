@@ -33,6 +33,7 @@ from __future__ import annotations
 import csv
 import math
 import re
+import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -207,7 +208,7 @@ def _load_numpy(path: Path) -> _Variables:
             raise FormatError(f"{path}: holds pickled Python objects, which are not read (unsafe); save named "
                               "arrays with np.savez") from None
         raise FormatError(f"{path}: not a readable NumPy file ({e})") from None
-    except (OSError, EOFError) as e:
+    except (OSError, EOFError, zipfile.BadZipFile) as e:  # an .npz is a zip: a damaged one is BadZipFile
         raise FormatError(f"{path}: not a readable NumPy file ({e})") from None
     if isinstance(obj, np.lib.npyio.NpzFile):
         with obj:
@@ -667,6 +668,8 @@ def to_scan(sw: Sweeps, pol: str, height_m: float = 0.0, antenna: Antenna | None
     else:
         rail, heights = sw.position.copy(), np.full(n, float(height_m))
     flags = (~np.all(np.isfinite(sw.samples), axis=1)).astype(np.uint8)
+    if n and flags.all():
+        raise FormatError(f"every one of the {n} sweeps holds a NaN or inf sample: nothing to focus")
     return Scan(s21=sw.samples.astype(np.complex64)[None], frequency=sw.frequency, rail_position=rail,
                 rail_height=heights, polarizations=(pol,), epoch_utc=epoch_utc, stop_time=np.zeros(n),
                 stop_flags=flags, antenna=antenna or Antenna(), instrument=dict(instrument or {}),

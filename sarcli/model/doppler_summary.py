@@ -57,6 +57,23 @@ def _floats(v: Any) -> np.ndarray:
     return np.array([np.nan if x is None else x for x in np.ravel(np.asarray(v, dtype=object))], np.float64)
 
 
+#: below this ambiguity confidence (the probability that the ambiguity's rounding is right) a resolved
+#: ambiguity is used only with a warning saying how confident and what to do (docs/doppler.md)
+AMBIGUITY_CONFIDENCE_LEVEL = 0.9
+
+
+def low_confidence_note(summary: Any) -> str | None:
+    """The warning for a resolved ambiguity of confidence below :data:`AMBIGUITY_CONFIDENCE_LEVEL`, or None."""
+    conf = getattr(summary, "ambiguity_confidence", None)
+    if summary is None or not summary.ambiguity_resolved or conf is None or not conf < AMBIGUITY_CONFIDENCE_LEVEL:
+        return None
+    return (f"the Doppler centroid's PRF ambiguity ({summary.ambiguity}, from {summary.ambiguity_source}) holds with "
+            f"confidence {conf:.2f} only (below {AMBIGUITY_CONFIDENCE_LEVEL:.2f}): the centroid may be a whole PRF off "
+            "(a defocused, shifted image); give the centroid with --fdc/--fr or the ambiguity with sarcli doppler "
+            "--ambiguity-value, estimate it on a longer scene or with an orbit, or accept it with "
+            "--accept-unresolved-ambiguity")
+
+
 @dataclass(frozen=True)
 class DataOnlyEstimate:
     """Absolute centroid of one data-only method (MLCC, MLBF, or ``combined``: their inverse-variance

@@ -25,6 +25,7 @@ from sarcli.model.raw import LOOK_SIDES
 POLARIZATIONS = ("VV", "VH", "HV", "HH")
 FREQUENCY_HZ = (1.0e3, 1.0e12)  # a VNA sweep
 SWEEP_RTOL = 1e-6  # a linear sweep: every step the mean step within this (VNA frequencies are computed)
+RAIL_SPAN_M = 1.0e3  # the longest rail (1-D scan): ground-based rails are metres to tens of metres
 HEIGHT_M = (-1.0e4, 1.0e4)  # antenna height above the reference, site height
 ANTENNA_LENGTH_M = (1e-3, 100.0)
 GAIN_DBI = (-50.0, 100.0)
@@ -158,6 +159,9 @@ class Scan:
                                    f"{k + 1} = {x[k + 1]:g} follows {x[k]:g}")
         else:
             ck.increasing(where, "rail_position", x)
+        if self.antenna_position is None and x.size and not np.ptp(x) <= RAIL_SPAN_M:
+            raise ProductError(f"{where}: rail_position spans {np.ptp(x):.6g} m: a ground-based rail is at most "
+                               f"{RAIL_SPAN_M:g} m long (positions in another unit?)")
         if self.reference_range is not None:
             rr = ck.array(where, "reference_range", self.reference_range, "f", shape=(n_stops,))
             if np.any(rr <= 0):

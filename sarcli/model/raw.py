@@ -16,6 +16,7 @@ import numpy as np
 
 from sarcli.errors import ProductError
 from sarcli.model import checks as ck
+from sarcli.model import plausible
 from sarcli.model.constants import C_LIGHT
 
 # Plausibility bounds of a raw product (SI). A value outside them is a damaged or mislabelled product,
@@ -35,6 +36,7 @@ EARTH_MU = 3.986004418e14  # m^3/s^2, WGS-84 GM
 EARTH_OMEGA = 7.2921151467e-5  # rad/s, WGS-84 rotation rate
 EARTH_POLAR_RADIUS_M = 6.356752e6  # WGS-84 b: an osculating perigee below it is a trajectory into the ground
 ORBIT_CHORD_RTOL = 0.1  # (p[k+1] - p[k]) / dt agrees with the mean velocity (when the arc is < 0.5 rad)
+MAX_SQUINT_RAD = np.radians(45.0)  # |pitch|, |yaw| of a side-looking SAR's flight frame (stripmap squints)
 ORBIT_FRAMES = ("ECI", "ECEF", "LOCAL")
 LOOK_SIDES = ("right", "left")
 
@@ -67,8 +69,9 @@ class Radar:
         """Refuse (one :class:`ProductError` line) a missing, mistyped or physically implausible parameter.
 
         Checks: every parameter a finite number; PRF, sampling rate and carrier within the module's bounds;
-        wavelength = c / carrier to 0.1 %; a non-zero chirp rate whose band |K| tau fits in the complex
-        sampling rate; pulse and receive window (``n_samples`` / fs, when known) within one pulse interval
+        wavelength = c / carrier to 0.1 %; a chirp of time-bandwidth product >= 0.01 whose band |K| tau fits
+        in the complex sampling rate; pulse and receive window (``n_samples`` / fs, when known) within one
+        pulse interval
         (a monostatic radar cannot receive while it transmits); first_range_m = c window_start_s / 2.
         """
         w = f"{where}: radar"
@@ -87,6 +90,7 @@ class Radar:
         if tau + window >= 1.0 / prf:
             raise ProductError(f"{w}: pulse ({tau * 1e6:.6g} us) plus receive window ({window * 1e6:.6g} us) "
                                f"exceed the pulse interval 1/PRF = {1e6 / prf:.6g} us")
+        plausible.chirp(w, k, tau)
         if abs(k) * tau > fs * (1.0 + 1e-9):
             raise ProductError(f"{w}: chirp band |K| tau = {abs(k) * tau / 1e6:.6g} MHz exceeds the sampling "
                                f"rate {fs / 1e6:.6g} MHz (the samples would alias)")
@@ -177,7 +181,8 @@ class Attitude:
     yaw: np.ndarray
 
     def validate(self, where: str = "attitude") -> None:
-        """Strictly increasing finite times; one finite angle per time for pitch, roll and yaw, |angle| <= pi."""
+        """Strictly increasing finite times; one finite angle per time for pitch, roll and yaw, |angle| <= pi;
+        |pitch|, |yaw| <= 45 degrees (:data:`MAX_SQUINT_RAD`)."""
         w = f"{where}: attitude"
         t = ck.array(w, "time", self.time, "f", ndim=1, min_size=1)
         ck.increasing(w, "time", t)
@@ -185,6 +190,10 @@ class Attitude:
             a = ck.array(w, name, getattr(self, name), "f", shape=(t.shape[0],))
             if np.any(np.abs(a) > np.pi):
                 raise ProductError(f"{w}: {name} exceeds pi rad in magnitude (angles are in radians)")
+            if name != "roll" and np.any(np.abs(a) > MAX_SQUINT_RAD):  # roll sets the look angle: any
+                raise ProductError(f"{w}: {name} reaches {np.degrees(np.abs(a).max()):.1f} degrees: a side-looking "
+                                   f"beam within {np.degrees(MAX_SQUINT_RAD):.0f} degrees of broadside cannot have it "
+                                   "(a yaw turned by 180 degrees? the attitude would predict the wrong Doppler)")
 
 
 @dataclass

@@ -174,6 +174,10 @@ def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.square(x, dtype=np.float64)))) if x.size else math.nan
 
 
+#: the percentile of |v| over the measured points reported as ``velocity_p95_mm_per_h``
+VELOCITY_PERCENTILE = 95.0
+
+
 def _f(x: float) -> float | None:
     return float(x) if x is not None and math.isfinite(x) else None
 
@@ -185,8 +189,9 @@ def base_record(index: int, time_posix: float, status: str, reason: str = "") ->
 def reject(state: State, index: int, time_posix: float, reason: str, failed: bool = False) -> Outcome:
     """Record a scan that is not used (``failed``: not acquired completely; else rejected by a check)."""
     rec = {**base_record(index, time_posix, "failed" if failed else "rejected", reason), "n_points": 0,
-           "aps_residual_mm": None, "max_velocity_mm_per_h": None,
-           "alarm_level": state.last_accepted_record.get("alarm_level", "none"), "displacement_mm": {}}
+           "aps_residual_mm": None, "max_velocity_mm_per_h": None, "velocity_p95_mm_per_h": None,
+           "alarm_velocity_mm_per_h": None, "alarm_level": state.last_accepted_record.get("alarm_level", "none"),
+           "displacement_mm": {}}
     state.last_scan = index
     if failed:
         state.n_failed += 1
@@ -262,7 +267,8 @@ def first_scan(cfg: MonitorConfig, st: Static, image: np.ndarray, index: int, ti
     s.n_accepted, s.last_scan = 1, index
     rec = {**base_record(index, time_posix, "accepted"), "n_points": 0, "n_stable": 0,
            "aps_residual_mm": None, "raw_stable_rms_mm": None, "aps_refractivity_ppm": None, "aps_model": "none",
-           "max_velocity_mm_per_h": None, "alarm_level": "none", "alarm_area": None,
+           "max_velocity_mm_per_h": None, "velocity_p95_mm_per_h": None, "alarm_velocity_mm_per_h": None,
+           "alarm_level": "none", "alarm_area": None,
            "displacement_mm": {w.name: 0.0 for w in cfg.watch}, "velocity_mm_per_h": {w.name: None for w in cfg.watch},
            "areas": {a.name: {"level": "none", "n_points": 0, "displacement_mm": None, "velocity_mm_per_h": None,
                               "acceleration_mm_per_h2": None, "forecast": None} for a in cfg.areas},
@@ -379,10 +385,15 @@ def update(cfg: MonitorConfig, st: Static, s: State, image: np.ndarray, index: i
     watch_d = {w.name: _f(float(new.displacement[r, c])) for w, (r, c) in zip(cfg.watch, st.watch, strict=True)}
     watch_v = {w.name: _f(float(new.velocity[r, c])) for w, (r, c) in zip(cfg.watch, st.watch, strict=True)}
     vel_pts = np.abs(new.velocity[measured])
+    # robust statistics: one noisy pixel sets the maximum, not the 95th percentile (which needs
+    # 5 % of the points) nor the areas' medians, which the alarms compare with their thresholds
+    area_v = [abs(a["velocity_mm_per_h"]) for a in areas_out.values() if a["velocity_mm_per_h"] is not None]
     rec = {**base_record(index, time_posix, "accepted"), "n_points": int(measured.sum()),
            "n_stable": int(new.stable.sum()), "aps_residual_mm": _f(residual), "raw_stable_rms_mm": _f(raw),
            "aps_refractivity_ppm": _f(model.refractivity_ppm(lam)) if kind in ("range", "range-height") else None,
            "aps_model": kind, "max_velocity_mm_per_h": _f(float(vel_pts.max())) if vel_pts.size else None,
+           "velocity_p95_mm_per_h": _f(float(np.percentile(vel_pts, VELOCITY_PERCENTILE))) if vel_pts.size else None,
+           "alarm_velocity_mm_per_h": _f(max(area_v)) if area_v else None,
            "alarm_level": LEVELS[top], "alarm_area": top_area, "displacement_mm": watch_d,
            "velocity_mm_per_h": watch_v, "areas": areas_out, "unwrapping": res.method,
            "implausible_fraction": res.implausible_fraction, "coherence_median": _f(coh_med), "time_h": t_h,

@@ -23,8 +23,9 @@ import numpy as np
 
 from orbit.propagate import Keplerian
 from sarcli.config import from_mapping, load_toml
-from sarcli.errors import ConfigError
+from sarcli.errors import ConfigError, ProductError
 from sarcli.model.constants import C_LIGHT
+from sarcli.model.raw import Radar
 
 PLATFORM_TYPES = ("orbit", "state_vectors", "linear")
 T = TypeVar("T")
@@ -313,6 +314,14 @@ def _radar(where: str, data: Any) -> RadarConfig:
         raise ConfigError(f"{where}.window_start_s: give exactly one of window_start_s or first_range_m")
     if t.chirp_rate_hz_per_s == 0:
         raise ConfigError(f"{where}.chirp_rate_hz_per_s: must be non-zero (sign = chirp direction)")
+    ws = t.window_start_s if t.window_start_s is not None else 2.0 * t.first_range_m / C_LIGHT
+    try:  # the checks of a raw product (what the HDF5, CEOS and Level-0 outputs will hold), before simulating
+        Radar(carrier_frequency_hz=t.carrier_frequency_hz, wavelength_m=C_LIGHT / t.carrier_frequency_hz,
+              prf_hz=t.prf_hz, range_sampling_rate_hz=t.range_sampling_rate_hz,
+              chirp_rate_hz_per_s=t.chirp_rate_hz_per_s, pulse_length_s=t.pulse_length_s, window_start_s=ws,
+              first_range_m=C_LIGHT * ws / 2.0).validate(where, t.n_samples)
+    except ProductError as e:
+        raise ConfigError(str(e)) from None
     return RadarConfig(
         carrier_frequency_hz=t.carrier_frequency_hz, prf_hz=t.prf_hz, range_sampling_rate_hz=t.range_sampling_rate_hz,
         chirp_rate_hz_per_s=t.chirp_rate_hz_per_s, pulse_length_s=t.pulse_length_s, n_lines=t.n_lines,

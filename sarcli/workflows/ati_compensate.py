@@ -116,7 +116,7 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
     from sarcli.ati.evaluation import truth_movers
 
     with base.using(provenance):
-        base.refuse_overwriting_inputs([config.raw], [config.output, config.png_dir])
+        base.refuse_overwriting_inputs([config.raw], [config.output, config.png_dir], folders=[config.png_dir])
         if config.png_dir is not None and config.png_dir.exists() and not config.png_dir.is_dir():
             raise ConfigError(f"png_dir: {config.png_dir} is not a folder")
         raw, pair, summary, results = estimate_movers(config.raw, config.route, config.unwrap, config.bin,

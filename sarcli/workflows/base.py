@@ -44,10 +44,18 @@ def _identity(path: Path) -> tuple[str, tuple[int, int] | None]:
 
 
 def refuse_overwriting_inputs(inputs: Iterable[str | os.PathLike | None],
-                              outputs: Iterable[str | os.PathLike | None]) -> None:
+                              outputs: Iterable[str | os.PathLike | None],
+                              folders: Iterable[str | os.PathLike | None] = ()) -> None:
     """Refuse, before any work, an output that is one of the inputs: the same real path (symbolic links
     resolved) or the same file under another name (a hard link: same device and inode), or an output
-    given twice. ``None`` entries are skipped. One :class:`ConfigError` line naming both."""
+    given twice; and an output file that is an existing folder (``folders``: the outputs that are
+    folders by design, a CEOS product, a folder of pictures). ``None`` entries are skipped. One
+    :class:`ConfigError` line naming both."""
+    outputs = list(outputs)
+    dirs = {os.path.realpath(p) for p in folders if p is not None}
+    for p in outputs:
+        if p is not None and os.path.realpath(p) not in dirs and Path(p).is_dir():
+            raise ConfigError(f"output {p} is an existing folder: give a file name (e.g. {Path(p) / 'out.h5'})")
     seen_in: dict[str | tuple[int, int], str | os.PathLike] = {}
     for p in inputs:
         if p is None:

@@ -132,6 +132,10 @@ class BatchReport(Report):
                    f"{c['up_to_date']} up to date, {c['failed']} failed, {c['skipped']} skipped"
                    + (f"; {len(self.ignored)} entr{'y' if len(self.ignored) == 1 else 'ies'} ignored"
                       if self.ignored else ""))
+        for s in self.scenes:
+            if s.get("warnings"):
+                out.append(f"{s['scene']}: " + ", ".join(f"{n} warning(s) in {k}" for k, n in s["warnings"].items())
+                           + f" (see {s['report']})")
         if self.performance_report:
             out.append(f"Dask performance report: {self.performance_report}")
         return out
@@ -303,6 +307,14 @@ def plan_scene(scene: Scene, out: Path, suffix: str, focus_extra: dict[str, Any]
     return _Plan(scene, o, steps, fresh)
 
 
+def _step_warnings(outcome: Any) -> list[str]:
+    """A step's warnings: those raised while it ran and those its workflow caught and listed in its report
+    (focus records its own), each once."""
+    value = outcome.value
+    own = value.get("warnings") if isinstance(value, dict) else getattr(value, "warnings", None)
+    return list(dict.fromkeys([*outcome.warnings, *(own or ())]))
+
+
 def _write_scene_report(plan: _Plan, outcomes: dict[str, Any]) -> None:
     from sarcli.io.atomic import atomic_path
     from sarcli.io.h5common import to_jsonable
@@ -311,7 +323,7 @@ def _write_scene_report(plan: _Plan, outcomes: dict[str, Any]) -> None:
     for s in plan.steps:
         o = outcomes[f"{plan.scene.name}:{s}"]
         steps.append({"step": s, "status": o.status, "seconds": o.seconds, "worker": o.worker, "error": o.error,
-                      "warnings": list(o.warnings), "report": o.value})
+                      "warnings": _step_warnings(o), "report": o.value})
     doc = {"scene": plan.scene.name, "input": str(plan.scene.source), "reader": plan.scene.reader or "raw product",
            "outputs": {k: str(v) for k, v in plan.outputs.items() if k != "report"}, "steps": steps}
     with atomic_path(plan.outputs["report"], ".json") as tmp, open(tmp, "w") as fh:
@@ -363,17 +375,20 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         rows = []
         for p in plans:
             status = {s: "up to date" for s in p.up_to_date}
+            warned: dict[str, int] = {}
             counts["up_to_date"] += len(p.up_to_date)
             for s in p.steps:
                 o = outcomes[f"{p.scene.name}:{s}"]
                 status[s] = o.status
+                if _step_warnings(o):
+                    warned[s] = len(_step_warnings(o))
                 counts[o.status] += 1
                 if o.status == "failed":
                     failures.append({"scene": p.scene.name, "step": s, "error": o.error})
             if p.steps:
                 _write_scene_report(p, outcomes)
             rows.append({"scene": p.scene.name, "input": str(p.scene.source),
-                         "steps": {s: status.get(s, "-") for s in STEPS if s in status},
+                         "steps": {s: status.get(s, "-") for s in STEPS if s in status}, "warnings": warned,
                          "report": str(p.outputs["report"]) if p.outputs["report"].exists() else None})
         return BatchReport(input=str(config.input), output=str(config.output), where=where, scenes=rows,
                            failures=failures, ignored=ignored, counts=counts, wall_s=time.perf_counter() - t0,

@@ -174,8 +174,11 @@ def _doppler_model(config: Config, raw, shape: tuple[int, int], terrain, load_ec
     """(model, how): from the Doppler product, from (fdc, fr), or estimated from the data."""
     if config.doppler is not None:
         from sarcli.io.doppler_product import read_doppler
+        from sarcli.model.plausible import doppler_model
 
-        return read_doppler(config.doppler), f"read from {config.doppler}"
+        model = read_doppler(config.doppler)
+        doppler_model(str(config.doppler), model, raw, shape)  # against the geometry, before use
+        return model, f"read from {config.doppler}"
     if config.fdc is not None and config.fr is not None:  # Config gives both or neither
         from sarcli.model.constants import C_LIGHT
         from sarcli.model.doppler import GeometricDoppler
@@ -197,6 +200,12 @@ def _refuse_unresolved(model, config: Config) -> None:
         raise ProductError("the Doppler centroid's PRF ambiguity is unresolved (the model may be whole PRFs off): "
                            "give the centroid with --fdc/--fr, resolve it in 'sarcli doppler' (an orbit, "
                            "--ambiguity), or accept it with --accept-unresolved-ambiguity")
+    from sarcli.model.doppler_summary import low_confidence_note
+
+    note = (None if config.accept_unresolved_ambiguity or config.doppler is None  # an estimate here has warned
+            else low_confidence_note(getattr(model, "summary", None)))
+    if note:
+        log.warning(note)
 
 
 def run(config: Config, provenance: Provenance | None = None, progress: Progress | None = None) -> FocusReport:

@@ -114,7 +114,7 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
     with base.using(provenance):
         sources = tuple(Path(s) for s in config.sources)
         output = Path(config.output)
-        base.refuse_overwriting_inputs(_input_files(sources), [output])
+        base.refuse_overwriting_inputs(_input_files(sources), [output], folders=[output])  # several products: a folder
         folder = output.resolve().parent
         if not folder.is_dir():
             raise ConfigError(f"output folder {folder} does not exist: create it first")

@@ -114,7 +114,8 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
     with base.using(provenance):
         output = Path(config.output)
         written = [output / name for name in SCENE_FILES] if config.format == "ceos" else [output]
-        base.refuse_overwriting_inputs([config.scene], [output] + (written if config.format == "ceos" else []))
+        base.refuse_overwriting_inputs([config.scene], [output] + (written if config.format == "ceos" else []),
+                                       folders=[output] if config.format == "ceos" else [])
         if not output.resolve().parent.is_dir():
             raise ConfigError(f"output folder {output.resolve().parent} does not exist: create it first")
         if output.is_dir() and config.format != "ceos":
@@ -125,6 +126,11 @@ def run(config: Config, provenance: base.Provenance | None = None, progress: bas
             sc.seed = config.seed
         if config.format == "ceos":
             check_ceos_scene(sc)
+        from sarcli.memory import fits_in_memory
+
+        channels = 2 if "second_channel" in sc.effects else 1  # the echo and a complex128 working copy of it
+        fits_in_memory(f"simulating {sc.radar.n_lines} x {sc.radar.n_samples} samples",
+                       channels * sc.radar.n_lines * sc.radar.n_samples * (8.0 + 16.0))
         total = sc.radar.n_lines * (2 if sc.clutter and sc.clutter_model == "binned" else 1)
         done = 0
 

@@ -32,7 +32,7 @@ def _ok(*args) -> None:
 @pytest.fixture(scope="session")
 def pristine() -> Iterator[Pristine]:
     """raw.h5 + its CEOS folder, doppler.h5, slc.h5 (tiny Radarsat-1-like scene); two GB-SAR scans,
-    their images (the second scene differs by its noise seed) and their interferogram."""
+    their images (the second scene differs by its noise seed) and their interferogram; the two scene files."""
     d = Path(tempfile.mkdtemp(prefix="sarcli-pristine-", dir=SCRATCH))  # beside the cases: hard links work
     try:
         with pytest.MonkeyPatch.context() as mp:  # byte-identical products every run: same cases, same bytes
@@ -47,7 +47,10 @@ def pristine() -> Iterator[Pristine]:
 def _make_pristine(d: Path) -> Pristine:
     p = {k: d / n for k, n in (("raw", "raw.h5"), ("ceos", "ceos"), ("doppler", "doppler.h5"), ("slc", "slc.h5"),
                               ("scan", "scan.h5"), ("scan2", "scan2.h5"), ("image", "image.h5"),
-                              ("image2", "image2.h5"), ("ifg", "ifg.h5"))}
+                              ("image2", "image2.h5"), ("ifg", "ifg.h5"), ("rs1_toml", "tiny_rs1.toml"),
+                              ("gbsar_toml", "tiny_gbsar.toml"))}
+    for key, name in (("rs1_toml", "tiny_rs1.toml"), ("gbsar_toml", "tiny_gbsar.toml")):
+        shutil.copyfile(SCENES / name, p[key])  # the scene files, damaged by the scene fuzz
     _ok("simulate", SCENES / "tiny_rs1.toml", "-o", p["raw"])
     _ok("simulate", SCENES / "tiny_rs1.toml", "--format", "ceos", "-o", p["ceos"])
     _ok("doppler", p["raw"], "-o", p["doppler"])

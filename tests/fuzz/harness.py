@@ -116,6 +116,8 @@ class DataEdit:
                 a = a.flat[0] if a.size else np.float64(0.0)
             elif op == "scale" and a.dtype.kind in "fc":
                 a = a * self.factor
+            elif op == "add" and a.dtype.kind in "fc":
+                a = a + self.factor
             elif op == "to_int" and a.dtype.kind in "fc":
                 a = np.real(a).astype(np.int32) if np.all(np.isfinite(np.real(a))) else np.zeros(a.shape, np.int32)
             elif op == "to_str" and a.dtype.names is None:
@@ -178,7 +180,30 @@ class ByteEdit:
         p.write_bytes(bytes(data))
 
 
-Corruption = AttrEdit | DataEdit | GroupEdit | ByteEdit
+@dataclasses.dataclass(frozen=True)
+class TextEdit:
+    """Replace the text ``old`` (which must occur) by ``new`` in the text file ``file`` (a scene file)."""
+
+    file: str
+    old: str
+    new: str
+
+    def apply(self, root: Path, target: str) -> None:
+        p = root / self.file
+        text = p.read_text()
+        assert self.old in text, f"{self.file} has no {self.old!r}"
+        p.write_text(text.replace(self.old, self.new))
+
+
+@dataclasses.dataclass(frozen=True)
+class NoEdit:
+    """The pristine product itself (a case whose hostile part is the command line)."""
+
+    def apply(self, root: Path, target: str) -> None:
+        return None
+
+
+Corruption = AttrEdit | DataEdit | GroupEdit | ByteEdit | TextEdit | NoEdit
 
 
 @dataclasses.dataclass(frozen=True)
@@ -394,7 +419,9 @@ def check_output(kind: str, path: Path, outcome: Outcome) -> None:
     from sarcli.io.h5common import open_product
 
     suffix = path.suffix
-    if suffix == ".h5":
+    if path.is_dir():  # a CEOS product folder
+        assert any(p.stat().st_size > 0 for p in path.iterdir()), f"empty product folder: {outcome.case}"
+    elif suffix == ".h5":
         with open_product(path) as f:
             ptype = f.attrs["product_type"]
         if ptype == "raw":
@@ -415,6 +442,15 @@ def check_output(kind: str, path: Path, outcome: Outcome) -> None:
             assert math.isfinite(fdc) and math.isfinite(fr) and fr < 0, f"implausible Doppler {fdc}, {fr}: " \
                                                                          f"{outcome.case}"
             assert math.isfinite(m.prf_hz) and m.prf_hz > 0
+            if m.summary is not None:  # physics, not only the type: the centroid within 2 V / lam of the
+                # platform the product's own effective velocity implies, the rate negative (plausible.py)
+                v = math.sqrt(-fr * m.wavelength_m * r0 / 2.0)
+                assert abs(fdc) <= 2.0 * 1.2e4 / m.wavelength_m and v <= 1.2e4, \
+                    f"implausible Doppler fdc {fdc:.6g} Hz, V {v:.6g} m/s: {outcome.case}"
+        elif ptype == "gbsar_scan":
+            from sarcli.io.scan import read_scan
+
+            read_scan(path)
         elif ptype == "gbsar_image":
             from sarcli.io.gbsar_image import read_gbsar_image
 
@@ -427,6 +463,7 @@ def check_output(kind: str, path: Path, outcome: Outcome) -> None:
             raise AssertionError(f"unexpected product type {ptype}: {outcome.case}")
     elif suffix in (".tif", ".png"):
         assert path.stat().st_size > 0
+
     if "--json" in outcome.case.split("sarcli ", 1)[1].split():
         _finite_json(json.loads(outcome.stdout), "json")
     else:

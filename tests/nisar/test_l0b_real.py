@@ -203,3 +203,10 @@ def test_partial_focus_marks_no_full_line(l0b_raw, doppler_model):
     assert slc.parameters["aperture_lines"] > 7 * l0b_raw.shape[0]
     assert slc.first_full_line > slc.last_full_line
     assert np.all(np.isfinite(slc.image.view(np.float32)))
+    # an image of it would hold no valid pixel: refused, saying why; the tag says none (it read "3644..999")
+    from sarcli.errors import ProductError
+    from sarcli.focus.geocode import full_rows, slc_tags
+
+    with pytest.raises(ProductError, match="longer than the scene's 1000 lines"):
+        full_rows(slc, slc.image.shape[0], 1)
+    assert slc_tags(slc)["FULLY_FOCUSED_LINES"].startswith("none of 1000")

@@ -140,9 +140,7 @@ def focus(
             bar.update(1)
 
         rep = run(config, progress=progress)
-    for w in rep.warnings:
-        info(f"sarcli: warning: {w}", as_json)
-    if as_json:
+    if as_json:  # the workflow has printed each warning once (its log); the report lists them
         emit_json(rep.to_dict())
     else:
         for line in rep.lines():

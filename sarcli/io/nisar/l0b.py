@@ -68,6 +68,7 @@ from sarcli.io.nisar.h5util import (
     time_axis,
 )
 from sarcli.model.constants import C_LIGHT
+from sarcli.model.plausible import sample_windows
 from sarcli.model.raw import Attitude, Orbit, Radar, RawProduct
 
 CAL_TYPES = {0: "HPA", 1: "LNA", 2: "BYPASS"}
@@ -179,6 +180,7 @@ def _read_grid(txg: h5py.Group, freq: str, tx: str, path: Path, notes: list[str]
         w = np.asarray(txg[key][()]).astype(np.int64)
         if w.shape != (n, 2):
             raise FormatError(f"{path}: {txg.name}/{key} has shape {w.shape}, expected ({n}, 2)")
+        sample_windows(str(path), f"{txg.name}/{key}", w, sr.size)
         windows.append(w)
     if not windows:
         windows = [np.tile(np.array([0, sr.size], np.int64), (n, 1))]

@@ -17,6 +17,10 @@ DOC = "thermal noise at snr_db (raw SNR of the illuminated samples) or at noise_
 ORDER = 20
 
 
+#: |snr_db| beyond it: 10**(snr/10) leaves float64's range of meaningful powers (no radar is near it)
+SNR_DB_LIMIT = 200.0
+
+
 @dataclass(frozen=True)
 class Options:
     """snr_db: raw SNR of the illuminated samples (dB); noise_power: E|n|^2 per complex sample. One of them."""
@@ -29,6 +33,9 @@ def parse(options, platform):
     if options is None or ((options.snr_db is None) == (options.noise_power is None)):
         raise ConfigError("effect noise needs a table [noise] with exactly one of snr_db or noise_power")
     if options.snr_db is not None:
+        if not -SNR_DB_LIMIT <= options.snr_db <= SNR_DB_LIMIT:
+            raise ConfigError(f"noise.snr_db: {options.snr_db:g} dB is implausible (expected -{SNR_DB_LIMIT:g} .. "
+                              f"{SNR_DB_LIMIT:g} dB; no noise at all: leave out the noise effect)")
         return ("snr_db", options.snr_db)
     if not options.noise_power > 0:
         raise ConfigError(f"noise.noise_power: must be > 0, got {options.noise_power!r}")
