@@ -17,7 +17,7 @@ from .theory import irf_theory
 
 C = 299792458.0
 REPO = Path(__file__).resolve().parents[2]
-SCENE = Path(__file__).parent / "scenes" / "batch.toml"
+SCENE = Path(__file__).parent / "scenes" / "batch_long.toml"  # longer than its aperture: GeoTIFFs hold pixels
 
 
 def _make(inp: Path, out: Path) -> subprocess.CompletedProcess:

@@ -12,7 +12,9 @@ from pathlib import Path
 import h5py
 import pytest
 
-SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch.toml"
+#: longer than its synthetic aperture, so that the GeoTIFFs hold fully focused lines (an image without a valid
+#: pixel is refused)
+SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch_long.toml"
 
 
 @pytest.fixture(scope="module")
@@ -21,13 +23,9 @@ def scenes(tmp_path_factory):
 
     inp = tmp_path_factory.mktemp("batch") / "in"
     inp.mkdir()
-    # 1024 lines: longer than the 708-line aperture, so that the GeoTIFFs hold fully focused lines (an image
-    # without a valid pixel is refused)
-    scene = inp.parent / "batch1024.toml"
-    scene.write_text(SCENE.read_text().replace("n_lines = 512", "n_lines = 1024"))
-    assert run_cli("simulate", scene, "-o", inp / "a.h5").exit_code == 0
+    assert run_cli("simulate", SCENE, "-o", inp / "a.h5").exit_code == 0
     shutil.copy(inp / "a.h5", inp / "b.h5")
-    assert run_cli("simulate", scene, "--format", "ceos", "-o", inp / "c").exit_code == 0
+    assert run_cli("simulate", SCENE, "--format", "ceos", "-o", inp / "c").exit_code == 0
     return inp
 
 

@@ -20,7 +20,7 @@ import h5py
 import numpy as np
 import pytest
 
-SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch.toml"
+SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch_long.toml"  # longer than its aperture: GeoTIFFs hold pixels
 BIN = Path(sys.executable).parent
 
 

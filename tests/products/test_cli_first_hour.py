@@ -45,7 +45,7 @@ def test_version_names_the_libraries_as_they_report_themselves(cli):
 
 
 @pytest.mark.parametrize("args, shown", [
-    (("gbsar", "focus"), "[auto|df|rd|bp]"), (("gbsar", "interfere"), "[dinsar|crosstrack|deltaf|combined]"),
+    (("gbsar", "focus"), "[auto|df|rd|bp|ffbp]"), (("gbsar", "interfere"), "[dinsar|crosstrack|deltaf|combined]"),
     (("simulate",), "[hdf5|ceos|s1-l0]"), (("doppler",), "[auto|orbit|data|none]"),
     (("export",), "[nisar-rslc|sicd|envi|PLUG-IN]"), (("ingest",), "[auto|gzip|lzf|none]")])
 def test_choices_in_help(cli, args, shown):
