@@ -124,3 +124,20 @@ def test_tile_size_does_not_change_the_image(monkeypatch):
     n = slc.parameters["azimuth_fft_length"] * slc.parameters["range_fft_length"]
     peak = float(np.abs(slc.image).max())
     assert np.max(np.abs(slc.image - b)) <= 2 * np.log2(n) * np.finfo(np.float32).eps * peak
+
+
+def test_device_option_is_checked_before_any_work(monkeypatch):
+    """``OmegakOptions.device`` is normalised, and ``cuda`` without CuPy is one line (exit 2 at the CLI)."""
+    import sys
+
+    from sarcli.errors import ConfigError
+    from sarcli.focus.omegak import OmegakOptions
+
+    monkeypatch.setenv("NUMBA_ENABLE_CUDASIM", "1")
+    assert OmegakOptions(device=" CUDA ").device == "cuda"
+    monkeypatch.delenv("NUMBA_ENABLE_CUDASIM")
+    monkeypatch.setitem(sys.modules, "cupy", None)  # a None entry makes the import raise ImportError
+    with pytest.raises(ConfigError, match="needs CuPy"):
+        OmegakOptions(device="cuda")
+    with pytest.raises(ConfigError, match="unknown device"):
+        OmegakOptions(device="gpu")
