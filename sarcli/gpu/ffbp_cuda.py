@@ -7,7 +7,8 @@ kernels call them from ``prange`` loops; here the same Python source of each hel
 compiled a second time as a CUDA device function (:func:`_twin`), its calls to the other helpers bound to their
 CUDA twins. The kernels below only map a thread to its sample, give it ``cuda.local.array`` scratch instead of
 ``np.empty`` and store the result: no arithmetic is written twice. Under numba's CUDA simulator
-(``NUMBA_ENABLE_CUDASIM=1``) the device functions run as that Python source, which is what CI tests.
+(``NUMBA_ENABLE_CUDASIM=1``) the device functions run as that Python source, which is what CI tests; their
+compiled CUDA form has not yet been built on a card (no GPU machine was lent to the session that wrote this).
 
 **Precision, and the bound the tests use.** Unlike :mod:`sarcli.gpu.bp_cuda`, FFBP on the GPU keeps the CPU's
 precisions exactly: float64 geometry and phase (the same polynomial ``_cis``, no float32 cosine), complex128
