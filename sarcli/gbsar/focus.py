@@ -108,8 +108,8 @@ class FocusOptions:
     knobs of ``algorithm`` ffbp (:class:`sarcli.focus.ffbp.FfbpKnobs`; aperture_split 64: a rail's footprint
     apertures are short, so most of them are backprojected stop by stop, as BP does);
     ``bp_precision``: single | double, the grid backprojection kernel (float32 phasor recurrence or float64);
-    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU
-    (:mod:`sarcli.gpu.bp_cuda`; DF and RD stay on the CPU).
+    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) and ffbp on the GPU
+    (:mod:`sarcli.gpu.bp_cuda`, :mod:`sarcli.gpu.ffbp_cuda`; DF and RD stay on the CPU).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
@@ -135,9 +135,6 @@ class FocusOptions:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "device", check_device(self.device))
-        if self.device == "cuda" and self.algorithm == "ffbp":
-            raise ConfigError("ffbp runs on the CPU only (no CUDA kernels for its merge stages yet): use --device "
-                              "cpu, or --algorithm bp --device cuda")
         if self.algorithm not in ALGORITHMS:
             raise ConfigError(f"unknown algorithm '{self.algorithm}' (use {', '.join(ALGORITHMS)})")
         if self.near not in ("rd", "bp"):
@@ -255,7 +252,7 @@ def _ffbp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions
     prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
     return ffbp_slant(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
-                      opts.azimuth_window, opts.ffbp)
+                      opts.azimuth_window, opts.ffbp, device=opts.device)
 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
@@ -412,7 +409,7 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
             raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
         if opts.algorithm == "ffbp":
             image[ip], frac = ffbp_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
-                                        opts.azimuth_window, opts.ffbp)
+                                        opts.azimuth_window, opts.ffbp, device=opts.device)
         else:
             image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
                                                opts.azimuth_window, opts.bp_precision, opts.device)

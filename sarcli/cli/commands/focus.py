@@ -80,8 +80,8 @@ def focus(
     scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
                                   "scheduler (tcp://host:8786; the raw file must be visible to its workers)."),
     device: str = typer.Option(None, "--device", metavar="[cpu|cuda]", envvar="SARCLI_DEVICE",
-                               help="Where the focuser runs: cpu (default) or cuda (rd, csa, omegak and backprojection;"
-                               " needs a GPU and the gpu extra, docs/parallel.md)."),
+                               help="Where the focuser runs: cpu (default) or cuda (rd, csa, omegak, backprojection "
+                               "and ffbp; needs a GPU and the gpu extra, docs/parallel.md)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON report on stdout."),
 ) -> None:
     """Focus a stripmap raw product into a single-look complex image.
