@@ -35,23 +35,24 @@ Residual phase per algorithm (target at R0, reference range R_ref = mid-swath, V
   interpolation (sinc8 on a 2x range grid) adds < 0.3 % of IRW (``bench_focus``): not modelled.
 - ``csa``: the chirp-scaling algorithm [Raney1994] keeps the same second-order expansion (its
   scaled chirp rate K_m(f) is that of R_ref): the same residual as ``rd`` [CumWong2005, sec. 7.4-7.6].
-- ``omegak`` with ``stolt = "full"``: the Stolt mapping x -> sqrt((f0 + x)^2 - a^2) - f0 is exact
+- ``omegak`` (knobs ``stolt``, ``stolt_kernel``, ``stolt_oversample``) with ``stolt = "full"``: the
+  Stolt mapping x -> sqrt((f0 + x)^2 - a^2) - f0 is exact
   for a straight track at V_ref [Cafforio1991; Bamler1992]: no residual on a linear track; on an
   orbit V varies with range, ``dPhi = -(4 pi R0 / c) [g(x, f; V(R0)) - g(x, f; V_ref)]``
   [CumWong2005, sec. 8.3.4]. The interpolation kernel adds a complex error of relative size
-  ``eps_L`` (:func:`kernel_error`: RMS over the band at the range oversampling fs / B), a floor.
+  ``eps_L`` (:func:`kernel_error`: RMS over the band |nu| <= 1 / (2 stolt_oversample)), a floor.
   ``stolt = "monochromatic"``: the bulk reference at R_ref is exact, the differential Stolt is
   replaced by its first-order (monochromatic) term [CumWong2005, sec. 8.4]:
   ``dPhi = -(4 pi (R0 - R_ref) / c) H(x, f)`` (+ the velocity term on an orbit).
 - ``backprojection``: exact (the sum over pulses along the true track); the linear interpolation of
   range lines upsampled U times weights the range band by sinc^2(x / (U fs)).
-- ``ffbp`` [Ulander2003]: no systematic phase; each of ``n = ceil(log_F N_ap)`` merging stages
-  interpolates beams sampled at ``k`` times the angular Nyquist rate lam / (2 l) of a subaperture of
-  length l with an interpolator of order p. The largest range error across a subaperture when the
-  nearest beam is used is l/2 * dtheta/2, i.e. a phase pi / (2 k) (p = 0); an interpolator of order
-  p leaves the Taylor remainder ``eps_p = (pi / (2 k))^(p+1) / (p+1)!`` of the phasor at the band
-  edge, RMS over the band eps_p / sqrt(2p + 3); stages add in power: ``eps = sqrt(n) eps_p /
-  sqrt(2p + 3)``. Modelled as a floor.
+- ``ffbp`` [Ulander2003] (knobs of ``sarcli.focus.ffbp``: ``base`` pulses per subaperture and merge,
+  angular ``oversample`` beta, ``order`` / ``range_order`` interpolation taps): no systematic phase;
+  each of the S merge stages and the last one interpolates once in angle and once in range, with the
+  error of interpolating exp(j 2 pi nu x), |nu| <= 1/(2 beta): (pi / beta)^2 / 8 for linear, 1 /
+  cosh(pi (1 - 1/beta) N / 2) for an N-tap Knab-windowed sinc; coherent at a peak, ``eps = (S + 1)
+  (e_order(beta) + e_range_order(U))`` (a worst case: the band's edges weighted down by the windows
+  make the measured error smaller). Modelled as a floor.
 
 A floor (a complex error of RMS eps relative to the peak, spread over the image, not a phase law)
 moves the peak phase by up to asin(eps); spread over the ~10 cells of a cut's sidelobe region it
@@ -81,11 +82,11 @@ from sarcli.focus.windows import window
 KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
     "rd": [{}],
     "csa": [{}],
-    "omegak": [{"stolt": "monochromatic"}, {"stolt": "full", "kernel_length": 8},
-               {"stolt": "full", "kernel_length": 16}],
-    "ffbp": [{"subaperture_factor": 2, "angular_oversampling": 2.0, "interpolation_order": 1},
-             {"subaperture_factor": 2, "angular_oversampling": 4.0, "interpolation_order": 1},
-             {"subaperture_factor": 2, "angular_oversampling": 4.0, "interpolation_order": 3}],
+    "omegak": [{"stolt": "monochromatic"}, {"stolt": "full", "stolt_kernel": "sinc8"},
+               {"stolt": "full", "stolt_kernel": "sinc16"}],
+    "ffbp": [{"base": 4, "oversample": 2.0, "order": 2, "range_order": 2},
+             {"base": 4, "oversample": 2.0, "order": 6, "range_order": 6},
+             {"base": 4, "oversample": 3.0, "order": 8, "range_order": 8}],
     "backprojection": [{}],
 }
 
@@ -93,19 +94,23 @@ KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
 #: per algorithm. ``rd`` and ``backprojection``: measured by bench/bench_focus_family.py (see
 #: docs/focusing.md); the others are operation counts relative to the RDA [CumWong2005, sec. 7.7,
 #: 8.5; Ulander2003, sec. IV] until the map measures them after they are registered.
-COST_RD = 3.3  # whole RD focus / two fft2 (bench_focus_family, median over its scenes)
-COST_CSA = 2.6  # 2 fft2 + 3 phase multiplies, no interpolation: RD minus its RCMC interpolation
-COST_OMEGAK_MONO = 2.6  # 2 fft2 + a phase multiply and a range shift per azimuth frequency
+COST_RD = 3.1  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.3-6.8 on a loaded machine)
+COST_CSA = COST_RD  # 2 fft2 + 3 phase multiplies, no interpolation (C&W: about the RDA's cost); a tie goes to rd
+COST_OMEGAK_MONO = COST_RD  # 2 fft2 + a phase multiply and RD's RCMC kernel: the RDA's cost
 COST_OMEGAK_PER_TAP = 0.12  # full Stolt: + this per kernel tap (an L-tap complex interpolation per sample)
+#: ffbp: a merge's interpolation tap (a complex multiply-add) against one exact backprojection term (a
+#: square root, a sine and cosine, a linear interpolation: ~40 flops against ~8)
+COST_FFBP_TAP = 0.2
 #: backprojection: seconds per (pixel x aperture line) over seconds per (sample x log2 samples) of two fft2
-COST_BP = 1.0
+COST_BP = 64.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block
 #: the 2 fft2 time per (sample x log2 samples) on the bench machine (s): predicted seconds for the report
-SECONDS_2FFT2 = 1.6e-9
-#: the largest |squint| (deg) at which the map validated an algorithm's model (bench_focus_family): beyond
-#: it the RDA showed errors its spectral phase model does not hold (a range offset from the hyperbolic
-#: model of an orbit, 0.3 pixel at 10 deg; an azimuth offset of 0.84 line on an airborne line at 10 deg,
-#: whatever the band or carrier), so ``auto`` does not rely on it there (docs/focusing.md)
-VALIDATED_SQUINT_DEG = {"rd": 5.0}
+SECONDS_2FFT2 = 1.4e-8  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
+#: on an ORBIT, the largest |squint| (deg) at which the map validated the hyperbolic-model focusers: beyond
+#: it the orbit's range history departs from the hyperbola over the beam offset R0 tan(theta) / V (21 s at
+#: 10 deg from 850 km) and the RDA showed a range offset of 0.38 pixel and 1.8 rad of peak phase at 10 deg
+#: (C band) that the spectral phase models do not hold; ``auto`` does not rely on them there
+#: (docs/focusing.md). On a straight line the hyperbola is exact: no limit.
+VALIDATED_SQUINT_DEG = {"rd": 5.0, "csa": 5.0, "omegak": 5.0}
 
 
 @dataclass(frozen=True)
@@ -243,27 +248,48 @@ def beyond_first_order(x: np.ndarray, f: np.ndarray, f0: float, v: float) -> np.
     return (2.0 * f0 * x + x * x) / (g + g0) - x * f0 / g0
 
 
-def kernel_error(taps: int, band_fraction: float) -> float:
+def kernel_error(name: str, band_fraction: float) -> float:
     """eps_L: the RMS of |interpolated - exact| of a unit phasor over the frequencies |nu| <=
-    ``band_fraction`` cycles per sample and the fractional shifts, for the project's windowed-sinc
-    interpolator of ``taps`` taps (:func:`sarcli.focus.interp.sinc_weights`)."""
-    from sarcli.focus.interp import sinc_weights
+    ``band_fraction`` cycles per sample and the fractional shifts, for the project's interpolator
+    ``name`` (:func:`sarcli.focus.interp.parse_interpolator`: linear, sinc4/8/16)."""
+    from sarcli.focus.interp import parse_interpolator, sinc_weights
 
+    kind, taps = parse_interpolator(name)
     mu = np.linspace(0.0, 1.0, 33)
-    w = sinc_weights(int(taps), mu)
-    k = np.arange(-(taps // 2 - 1), taps // 2 + 1)
+    if kind == 2:
+        w = sinc_weights(int(taps), mu)
+        k = np.arange(-(taps // 2 - 1), taps // 2 + 1)
+    else:  # linear (nearest counted as linear: the coarsest the project's Stolt offers)
+        w = np.stack([1.0 - mu, mu], -1)
+        k = np.arange(2)
     nu = np.linspace(-band_fraction, band_fraction, 33)
     got = np.einsum("mk,mkn->mn", w, np.exp(2j * np.pi * nu[None, None, :] * (k[None, :, None] - mu[:, None, None])))
     return float(np.sqrt(np.mean(np.abs(got - 1.0) ** 2)))
 
 
-def ffbp_floor(n_aperture: float, factor: int, oversampling: float, order: int) -> float:
-    """eps = sqrt(n) (pi / (2 k))^(p+1) / (p+1)! / sqrt(2p + 3), n = ceil(log_F N_ap) stages: the
-    module docstring's bound at the band edge, as an RMS over a flat angular spectrum (the error grows
-    as nu^(p+1): the mean of nu^(2p+2) over [0, 1] is 1 / (2p + 3))."""
-    stages = max(1, math.ceil(math.log(max(n_aperture, 2.0)) / math.log(max(int(factor), 2))))
-    edge = (math.pi / (2.0 * oversampling)) ** (order + 1) / math.factorial(order + 1)
-    return math.sqrt(stages) * edge / math.sqrt(2 * order + 3)
+def ffbp_kernel_error(taps: int, oversample: float) -> float:
+    """The largest error of interpolating exp(j 2 pi nu x), |nu| <= 1 / (2 beta), with FFBP's kernels
+    [Ulander2003; Knab's prolate-windowed sinc]: (pi / beta)^2 / 8 for 2 taps (linear), 1 / cosh(pi v N
+    / 2) with v = 1 - 1 / beta for N >= 4 taps."""
+    if taps <= 2:
+        return (math.pi / oversample) ** 2 / 8.0
+    return 1.0 / math.cosh(math.pi * (1.0 - 1.0 / oversample) * taps / 2.0)
+
+
+def ffbp_stages(n_aperture: float, base: int) -> int:
+    """Merge stages S from subapertures of ``base`` pulses to the synthetic aperture of ``n_aperture``."""
+    return max(1, math.ceil(math.log(max(n_aperture / max(base, 2), 2.0)) / math.log(max(base, 2))))
+
+
+def ffbp_floor(n_aperture: float, knobs: dict[str, Any], range_oversample: float = 2.0) -> float:
+    """eps <= (S + 1) (e_order(beta) + e_range_order(U)): every merge and the last stage interpolate
+    once in angle (``order`` taps at the angular oversampling beta) and in range (``range_order`` taps
+    at U = ``range_oversample``), coherent at a scatterer's peak [Ulander2003] (module docstring)."""
+    base = int(knobs.get("base", 4))
+    s = ffbp_stages(n_aperture, base)
+    e = ffbp_kernel_error(int(knobs.get("order", 6)), float(knobs.get("oversample", 2.0)))
+    e += ffbp_kernel_error(int(knobs.get("range_order", 6)), float(knobs.get("range_oversample", range_oversample)))
+    return (s + 1) * e
 
 
 def residual_phase(algorithm: str, knobs: dict[str, Any], geom: Geometry, r0: float, x: np.ndarray,
@@ -286,16 +312,15 @@ def residual_phase(algorithm: str, knobs: dict[str, Any], geom: Geometry, r0: fl
         if knobs.get("stolt", "full") == "monochromatic":
             dphi = dphi - (4.0 * np.pi * (r0 - r_ref) / C) * beyond_first_order(x, f, f0, v0)
         else:
-            eps = kernel_error(int(knobs.get("kernel_length", 8)),
-                               0.5 * geom.range_bandwidth_hz / geom.range_sampling_hz)
+            eps = kernel_error(str(knobs.get("stolt_kernel", "sinc16")),
+                               0.5 / float(knobs.get("stolt_oversample", 2.0)))
         return dphi + zero, amp, eps
     if algorithm == "backprojection":
         up = int(knobs.get("upsample", 8))
         amp = amp * np.sinc(x / (up * geom.range_sampling_hz)) ** 2
         return zero, amp, 0.0
     if algorithm == "ffbp":
-        eps = ffbp_floor(geom.aperture_lines, int(knobs.get("subaperture_factor", 2)),
-                         float(knobs.get("angular_oversampling", 2.0)), int(knobs.get("interpolation_order", 1)))
+        eps = ffbp_floor(geom.aperture_lines, knobs)
         return zero, amp, eps
     raise SarcliError(f"no error model for focuser {algorithm!r}")
 
@@ -411,8 +436,9 @@ def predict(algorithm: str, knobs: dict[str, Any], geom: Geometry,
                "irw_range": float(e["irw_range"]), "irw_azimuth": float(e["irw_azimuth"]),
                "pslr_range_db": float(e["pslr_range_db"]), "pslr_azimuth_db": float(e["pslr_azimuth_db"])}
         if not worst:
-            limit = VALIDATED_SQUINT_DEG.get(algorithm)
-            cur["validated"] = limit is None or abs(geom.squint_deg) <= limit + 1e-9
+            limit = VALIDATED_SQUINT_DEG.get(algorithm) if geom.track == "orbit" else None
+            # + 0.25 deg: a nominal 5-deg scene of the map is 5.0001 deg by its mid-swath velocity
+            cur["validated"] = limit is None or abs(geom.squint_deg) <= limit + 0.25
             worst = cur
         else:
             for k in ("irw", "pslr_db", "phase_rad", "position_m"):
@@ -438,14 +464,16 @@ def predicted_cost(algorithm: str, knobs: dict[str, Any], geom: Geometry) -> flo
     if algorithm == "omegak":
         if knobs.get("stolt", "full") == "monochromatic":
             return COST_OMEGAK_MONO
-        return COST_OMEGAK_MONO + COST_OMEGAK_PER_TAP * int(knobs.get("kernel_length", 8))
+        from sarcli.focus.interp import parse_interpolator
+
+        return COST_OMEGAK_MONO + COST_OMEGAK_PER_TAP * parse_interpolator(str(knobs.get("stolt_kernel", "sinc16")))[1]
     if algorithm == "backprojection":
         return COST_BP * geom.aperture_lines / log_n
     if algorithm == "ffbp":
-        factor = max(int(knobs.get("subaperture_factor", 2)), 2)
-        stages = max(1, math.ceil(math.log(max(geom.aperture_lines, 2.0)) / math.log(factor)))
-        per_pixel = factor * float(knobs.get("angular_oversampling", 2.0)) * stages * (
-            1 + int(knobs.get("interpolation_order", 1)))
+        base = int(knobs.get("base", 4))
+        taps = int(knobs.get("order", 6)) * int(knobs.get("range_order", 6))
+        per_pixel = (ffbp_stages(geom.aperture_lines, base) + 1) * base * float(knobs.get("oversample", 2.0)) * \
+            float(knobs.get("range_oversample", 2.0)) * taps * COST_FFBP_TAP
         return COST_BP * per_pixel / log_n
     raise SarcliError(f"no cost model for focuser {algorithm!r}")
 
@@ -579,13 +607,12 @@ def gbsar_near(n_stops: int, available: tuple[str, ...], azimuth_window: str = "
     s = window_pslr(azimuth_window)
     best = None
     for knobs in KNOB_SETTINGS["ffbp"]:
-        factor, k, p = (int(knobs["subaperture_factor"]), float(knobs["angular_oversampling"]),
-                        int(knobs["interpolation_order"]))
-        eps = ffbp_floor(float(n_stops), factor, k, p)
+        eps = ffbp_floor(float(n_stops), knobs)
         phase = math.asin(min(eps, 1.0))
         pslr = 20 * math.log10(1 + eps / (math.sqrt(SPREAD_CELLS) * s))
-        stages = max(1, math.ceil(math.log(max(n_stops, 2)) / math.log(max(factor, 2))))
-        cost = factor * k * stages * (p + 1)
+        base = int(knobs["base"])
+        cost = (ffbp_stages(n_stops, base) + 1) * base * float(knobs["oversample"]) * 2.0 * \
+            int(knobs["order"]) * int(knobs["range_order"]) * COST_FFBP_TAP
         if phase <= q.phase_rad and pslr <= q.pslr_db and cost < n_stops and (best is None or cost < best[0]):
             best = (cost, knobs, {"phase_rad": phase, "pslr_db": pslr, "irw": 0.0})
     if best is None:

@@ -221,7 +221,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         refuse_overwriting_inputs((config.raw, config.doppler, config.dem), config.outputs)
         _check_outputs(config)
         auto = config.algorithm == "auto"
-        focuser = None if auto else FOCUSERS.get(config.algorithm)
+        focuser: Any = None if auto else FOCUSERS.get(config.algorithm)  # auto: chosen below
         options = None if auto else options_for(focuser, config.options)
         from sarcli.io.dem import load_terrain
         from sarcli.io.raw import raw_shape, read_raw

@@ -172,3 +172,23 @@ def test_cli_quality_needs_auto(cli, tmp_path):
     raw = _write(tmp_path)
     r = cli("focus", raw, "-o", tmp_path / "slc.h5", "--quality", "irw=0.01", "--fdc", "0", "--fr", "-100")
     assert r.exit_code != 0 and "--algorithm auto" in r.stderr
+
+
+def test_gbsar_near_uses_ffbp_only_where_available_and_good():
+    from sarcli.focus.select import KNOB_SETTINGS, ffbp_floor, gbsar_near
+
+    assert gbsar_near(400, ("auto", "df", "rd", "bp"))[0] == "bp"
+    name, rep = gbsar_near(400, ("auto", "df", "rd", "bp", "ffbp"))
+    if name == "ffbp":  # the chosen setting's bound meets the phase budget and costs less than 400 terms
+        assert rep["ffbp_knobs"] in KNOB_SETTINGS["ffbp"]
+        assert math.asin(ffbp_floor(400.0, rep["ffbp_knobs"])) <= 0.1 and rep["cost_per_pixel"]["ffbp"] < 400
+    assert gbsar_near(8, ("bp", "ffbp"))[0] == "bp"  # 8 stops: backprojection is cheaper than any merge
+
+
+def test_ffbp_floor_follows_the_kernel_bounds():
+    """(S + 1)(e_order + e_range_order): linear (pi/beta)^2/8 each, 2 stages for 64 lines of base 4."""
+    from sarcli.focus.select import ffbp_floor, ffbp_stages
+
+    assert ffbp_stages(64.0, 4) == 2
+    knobs = {"base": 4, "oversample": 2.0, "order": 2, "range_order": 2}
+    assert ffbp_floor(64.0, knobs, range_oversample=2.0) == pytest.approx(3 * 2 * (math.pi / 2) ** 2 / 8)
