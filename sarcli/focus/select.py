@@ -325,7 +325,7 @@ def residual_phase(algorithm: str, knobs: dict[str, Any], geom: Geometry, r0: fl
     raise SarcliError(f"no error model for focuser {algorithm!r}")
 
 
-N_BAND = 80  # band samples per axis: the model IRF repeats every 79 resolution cells, beyond its chip
+N_BAND = 80  # band samples per axis: the model IRF repeats every 80 resolution cells, beyond its chip
 CHIP = 64  # model image chip (pixels per side), as the map's backprojected windows
 SPREAD_CELLS = 10  # cells per cut over which a floor's energy is spread (module docstring)
 
@@ -417,12 +417,12 @@ def predict(algorithm: str, knobs: dict[str, Any], geom: Geometry,
     (largest shift, range and azimuth in m on the ground track), each the worst over the ranges; and
     the signed per-axis IRW and PSLR changes (irw_range, irw_azimuth, pslr_range_db,
     pslr_azimuth_db) at the first range."""
-    # azimuth frequencies: the processed band and its shear |fdc| B / (2 f0) either side
-    span = geom.azimuth_bandwidth_hz + abs(geom.fdc_hz) * geom.relative_bandwidth
-    n_az = max(N_BAND, int(math.ceil(1.25 * span * CHIP / geom.prf_hz)))  # the IRF's period beyond the chip
-    # midpoint samples: no sample sits on a band edge, where the angular support's shear would flip it
+    # azimuth frequencies on midpoints of N_BAND cells across the processed band (its edges between
+    # samples: no cell half in, half out), plus whole cells either side for the shear |fdc| B / (2 f0)
+    df = geom.azimuth_bandwidth_hz / N_BAND
+    extra = int(math.ceil(0.5 * abs(geom.fdc_hz) * geom.relative_bandwidth / df)) + 1
+    f = geom.fdc_hz + (np.arange(-extra, N_BAND + extra) + 0.5 - 0.5 * N_BAND) * df
     x = ((np.arange(N_BAND) + 0.5) / N_BAND - 0.5) * geom.range_bandwidth_hz
-    f = geom.fdc_hz + ((np.arange(n_az) + 0.5) / n_az - 0.5) * span
     ideal, freq = supports(geom, x, f)
     support = ideal if algorithm in TIME_DOMAIN else freq
     worst: dict[str, float] = {}
