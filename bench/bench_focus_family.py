@@ -208,43 +208,52 @@ def limits(results: list[dict]) -> list[list]:
 
 
 def _plot(results: list[dict], path) -> None:
+    """Four panels against squint: the worst |PSLR change|, |peak phase error| and |IRW change| of each
+    focuser against exact backprojection (measured: o, predicted: x; dashed: the default quality) and its
+    time in two fft2 of the block (backprojection: extrapolated)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8))
+    fig, axes = plt.subplots(1, 4, figsize=(19, 4.8))
     keys = (("pslr", "worst |PSLR change| (dB)", 1.0), ("phase", "|peak phase error| (rad)", 0.1),
             ("irw", "worst |IRW change| (%)", 2.0))
-    styles = {}
+    styles: dict[str, int] = {}
     for r in results:
-        if r.get("bandwidth_sweep"):
+        if r.get("bandwidth_sweep") or r.get("skipped"):
             continue
         for row in r["rows"]:
-            if "measured" not in row or row["algorithm"] == "backprojection":
+            if "measured" not in row:
+                continue
+            label = f"{row['algorithm']} {json.dumps(row['knobs']) if row['knobs'] else ''} {r['band']} {r['platform']}"
+            new = label not in styles
+            styles.setdefault(label, len(styles))
+            c = plt.get_cmap("tab20")(styles[label] % 20)
+            axes[3].scatter(r["squint_deg"], row["ratio_to_2fft2"], color=c, marker="s" if row.get("extrapolated")
+                            else "o", label=label if new else None)
+            if row["algorithm"] == "backprojection":
                 continue
             m, p = row["measured"], row["predicted"]
-            label = f"{row['algorithm']} {r['band']} {r['platform']}"
             vals = {"pslr": (max(abs(m["pslr_range_db"]), abs(m["pslr_azimuth_db"])), p["pslr_db"]),
                     "phase": (abs(m["phase_rad"]), p["phase_rad"]),
                     "irw": (100 * max(abs(m["irw_range"]), abs(m["irw_azimuth"])), 100 * p["irw"])}
-            styles.setdefault(label, len(styles))
-            c = plt.get_cmap("tab10")(styles[label] % 10)
-            for ax, (k, _, _) in zip(axes, keys, strict=True):
-                ax.scatter(r["squint_deg"], max(vals[k][0], 1e-4), color=c, marker="o",
-                           label=label if k == "pslr" else None)
+            for ax, (k, _, _) in zip(axes, keys, strict=False):
+                ax.scatter(r["squint_deg"], max(vals[k][0], 1e-4), color=c, marker="o")
                 ax.scatter(r["squint_deg"], max(vals[k][1], 1e-4), color=c, marker="x")
-    for ax, (_, lab, lim) in zip(axes, keys, strict=True):
+    for ax, (_, lab, lim) in zip(axes, keys, strict=False):
         ax.axhline(lim, color="k", ls="--", lw=0.7)
+        ax.set_ylabel(lab)
+    axes[3].set_ylabel("time / two fft2 of the block (squares: extrapolated)")
+    for ax in axes:
         ax.set_yscale("log")
         ax.set_xlabel("squint (deg)")
-        ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7, loc="upper left")
+    axes[3].legend(fontsize=6, loc="center left", bbox_to_anchor=(1.0, 0.5))
     fig.suptitle("Focusers against exact backprojection: measured (o) and predicted by sarcli.focus.select (x); "
                  "dashed: the default quality")
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    fig.savefig(path, dpi=80)
     plt.close(fig)
 
 

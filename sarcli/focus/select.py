@@ -94,7 +94,7 @@ KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
 #: per algorithm. ``rd`` and ``backprojection``: measured by bench/bench_focus_family.py (see
 #: docs/focusing.md); the others are operation counts relative to the RDA [CumWong2005, sec. 7.7,
 #: 8.5; Ulander2003, sec. IV] until the map measures them after they are registered.
-COST_RD = 3.1  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.3-6.8 on a loaded machine)
+COST_RD = 3.0  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.2-13 on a loaded machine)
 COST_CSA = COST_RD  # 2 fft2 + 3 phase multiplies, no interpolation (C&W: about the RDA's cost); a tie goes to rd
 COST_OMEGAK_MONO = COST_RD  # 2 fft2 + a phase multiply and RD's RCMC kernel: the RDA's cost
 COST_OMEGAK_PER_TAP = 0.12  # full Stolt: + this per kernel tap (an L-tap complex interpolation per sample)
@@ -102,9 +102,9 @@ COST_OMEGAK_PER_TAP = 0.12  # full Stolt: + this per kernel tap (an L-tap comple
 #: square root, a sine and cosine, a linear interpolation: ~40 flops against ~8)
 COST_FFBP_TAP = 0.2
 #: backprojection: seconds per (pixel x aperture line) over seconds per (sample x log2 samples) of two fft2
-COST_BP = 64.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block
+COST_BP = 50.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block
 #: the 2 fft2 time per (sample x log2 samples) on the bench machine (s): predicted seconds for the report
-SECONDS_2FFT2 = 1.4e-8  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
+SECONDS_2FFT2 = 9.1e-9  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
 #: on an ORBIT, the largest |squint| (deg) at which the map validated the hyperbolic-model focusers: beyond
 #: it the orbit's range history departs from the hyperbola over the beam offset R0 tan(theta) / V (21 s at
 #: 10 deg from 850 km) and the RDA showed a range offset of 0.38 pixel and 1.8 rad of peak phase at 10 deg
