@@ -594,27 +594,29 @@ def window_pslr(spec: str) -> float:
 
 
 def gbsar_near(n_stops: int, available: tuple[str, ...], azimuth_window: str = "kaiser:2.5",
-               quality: Quality | None = None) -> tuple[str, dict[str, Any]]:
+               quality: Quality | None = None, knobs: dict[str, Any] | None = None) -> tuple[str, dict[str, Any]]:
     """GB-SAR ``auto``'s near-range algorithm (below the Deramp-FFT limit, :mod:`sarcli.gbsar.focus`):
     ``ffbp`` when ``available`` has it and the cheapest knob setting of ``KNOB_SETTINGS["ffbp"]`` whose
     floor (:func:`ffbp_floor` over ``n_stops`` stops) meets ``quality`` (phase asin(eps), PSLR change
     20 log10(1 + eps / (sqrt(10) s)) for the window's sidelobe s) is predicted cheaper than
     backprojection (per pixel F k n (p + 1) against n_stops); otherwise ``bp``. Returns (name, the
-    report's entry: the knobs the GB-SAR ffbp is to use, the predicted errors, the costs)."""
+    report's entry: the knobs the GB-SAR ffbp is to use, the predicted errors, the costs). ``knobs``:
+    the GB-SAR ffbp's own knobs where it has them (then only those are considered)."""
     q = quality or Quality()
     if "ffbp" not in available:
         return "bp", {"near": "bp", "why": "ffbp is not available"}
     s = window_pslr(azimuth_window)
     best = None
-    for knobs in KNOB_SETTINGS["ffbp"]:
-        eps = ffbp_floor(float(n_stops), knobs)
+    for setting in [knobs] if knobs is not None else KNOB_SETTINGS["ffbp"]:
+        eps = ffbp_floor(float(n_stops), setting)
         phase = math.asin(min(eps, 1.0))
         pslr = 20 * math.log10(1 + eps / (math.sqrt(SPREAD_CELLS) * s))
-        base = int(knobs["base"])
-        cost = (ffbp_stages(n_stops, base) + 1) * base * float(knobs["oversample"]) * 2.0 * \
-            int(knobs["order"]) * int(knobs["range_order"]) * COST_FFBP_TAP
+        base = int(setting.get("base", 4))
+        cost = (ffbp_stages(n_stops, base) + 1) * base * float(setting.get("oversample", 2.0)) * \
+            float(setting.get("range_oversample", 2.0)) * int(setting.get("order", 6)) * \
+            int(setting.get("range_order", 6)) * COST_FFBP_TAP
         if phase <= q.phase_rad and pslr <= q.pslr_db and cost < n_stops and (best is None or cost < best[0]):
-            best = (cost, knobs, {"phase_rad": phase, "pslr_db": pslr, "irw": 0.0})
+            best = (cost, dict(setting), {"phase_rad": phase, "pslr_db": pslr, "irw": 0.0})
     if best is None:
         return "bp", {"near": "bp", "why": f"no ffbp setting is predicted to meet the quality and cost less than "
                                            f"backprojection over {n_stops} stops"}

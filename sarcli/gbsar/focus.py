@@ -288,9 +288,13 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     uniform = x.size < 3 or np.allclose(np.diff(x), np.diff(x)[0], rtol=1e-6, atol=0)
     near, near_selection = opts.near, None
     if alg == "auto" and opts.near == "bp":  # ffbp instead where it is a GB-SAR algorithm and predicted good
+        from dataclasses import asdict
+
         from sarcli.focus.select import gbsar_near
 
-        near, near_selection = gbsar_near(x.size, ALGORITHMS, opts.azimuth_window)
+        own = getattr(opts, "ffbp", None)  # the GB-SAR ffbp's knobs, where it has them
+        near, near_selection = gbsar_near(x.size, ALGORITHMS, opts.azimuth_window,
+                                          knobs=asdict(own) if own is not None else None)
     if alg == "auto" and not uniform:
         alg_plan = {near if near == "ffbp" else "bp": np.arange(grid.ranges.size)}
     elif alg == "auto":
