@@ -34,16 +34,18 @@ Residual phase per algorithm (target at R0, reference range R_ref = mid-swath, V
   (pi B^2 / (2 c f0)) (R0 - R_ref) sin^2(theta) / cos^3(theta) [CumWong2005, sec. 6.3.3]. The RCMC
   interpolation (sinc8 on a 2x range grid) adds < 0.3 % of IRW (``bench_focus``): not modelled.
 - ``csa``: the chirp-scaling algorithm [Raney1994] keeps the same second-order expansion (its
-  scaled chirp rate K_m(f) is that of R_ref): the same residual as ``rd`` [CumWong2005, sec. 7.4-7.6].
+  scaled chirp rate K_m(f) is that of R_ref): the same residual as ``rd`` [CumWong2005, sec. 7.4-7.6],
+  with its own R_ref (``reference_range_m``, default the middle of the closest ranges the raw window
+  images, (R_near + R_far cos(theta)) / 2).
 - ``omegak`` (knobs ``stolt``, ``stolt_kernel``, ``stolt_oversample``) with ``stolt = "full"``: the
   Stolt mapping x -> sqrt((f0 + x)^2 - a^2) - f0 is exact
   for a straight track at V_ref [Cafforio1991; Bamler1992]: no residual on a linear track; on an
   orbit V varies with range, ``dPhi = -(4 pi R0 / c) [g(x, f; V(R0)) - g(x, f; V_ref)]``
   [CumWong2005, sec. 8.3.4]. The interpolation kernel adds a complex error of relative size
   ``eps_L`` (:func:`kernel_error`: RMS over the band |nu| <= 1 / (2 stolt_oversample)), a floor.
-  ``stolt = "monochromatic"``: the bulk reference at R_ref is exact, the differential Stolt is
-  replaced by its first-order (monochromatic) term [CumWong2005, sec. 8.4]:
-  ``dPhi = -(4 pi (R0 - R_ref) / c) H(x, f)`` (+ the velocity term on an orbit).
+  ``stolt = "monochromatic"``: the differential Stolt replaced by its first-order term [CumWong2005,
+  sec. 8.4] on RD's RCMC kernel and SRC: the residual of ``rd`` (bench_omegak measured the two
+  alike to 1e-4 rad at 0-40 deg).
 - ``backprojection``: exact (the sum over pulses along the true track); the linear interpolation of
   range lines upsampled U times weights the range band by sinc^2(x / (U fs)).
 - ``ffbp`` [Ulander2003] (knobs of ``sarcli.focus.ffbp``: ``base`` pulses per subaperture and merge,
@@ -95,9 +97,12 @@ KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
 #: docs/focusing.md); the others are operation counts relative to the RDA [CumWong2005, sec. 7.7,
 #: 8.5; Ulander2003, sec. IV] until the map measures them after they are registered.
 COST_RD = 3.0  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.2-13 on a loaded machine)
-COST_CSA = COST_RD  # 2 fft2 + 3 phase multiplies, no interpolation (C&W: about the RDA's cost); a tie goes to rd
-COST_OMEGAK_MONO = COST_RD  # 2 fft2 + a phase multiply and RD's RCMC kernel: the RDA's cost
-COST_OMEGAK_PER_TAP = 0.12  # full Stolt: + this per kernel tap (an L-tap complex interpolation per sample)
+# csa and omegak: their own benchmarks' ratio to rd on the same 1536 x 2048 block in the same run
+# (bench_csa: 1.28; bench_omegak: monochromatic 1.58, full Stolt 5.4 with sinc8 or sinc16: its longer
+# range FFT, not the kernel, dominates), until the map measures them on its scenes
+COST_CSA = 1.28 * COST_RD
+COST_OMEGAK_MONO = 1.58 * COST_RD
+COST_OMEGAK_FULL = 5.4 * COST_RD
 #: ffbp: a merge's interpolation tap (a complex multiply-add) against one exact backprojection term (a
 #: square root, a sine and cosine, a linear interpolation: ~40 flops against ~8)
 COST_FFBP_TAP = 0.2
@@ -300,7 +305,11 @@ def residual_phase(algorithm: str, knobs: dict[str, Any], geom: Geometry, r0: fl
     zero = np.zeros(np.broadcast(x, f).shape)
     amp = np.ones_like(zero)
     v0 = v + geom.dv_dr * (r0 - r_ref)  # the target's own effective velocity
-    if algorithm in ("rd", "csa"):
+    mono = algorithm == "omegak" and knobs.get("stolt", "full") == "monochromatic"
+    if algorithm in ("rd", "csa") or mono:
+        if algorithm == "csa":  # its R_ref: the middle of the closest ranges the raw window images
+            cos = math.cos(math.radians(geom.squint_deg))
+            r_ref = float(knobs.get("reference_range_m") or 0.5 * (geom.r_near_m + geom.r_far_m * cos))
         # SRC at R_ref with the velocity there (the RDA's mid-swath V)
         g0r = _g(np.zeros_like(x), f, f0, v)
         a2r = (C * f / (2.0 * v)) ** 2
@@ -308,12 +317,7 @@ def residual_phase(algorithm: str, knobs: dict[str, Any], geom: Geometry, r0: fl
         return dphi + zero, amp, 0.0
     if algorithm == "omegak":
         dphi = -(4.0 * np.pi * r0 / C) * (_g(x, f, f0, v0) - _g(x, f, f0, v)) if v0 != v else zero.copy()
-        eps = 0.0
-        if knobs.get("stolt", "full") == "monochromatic":
-            dphi = dphi - (4.0 * np.pi * (r0 - r_ref) / C) * beyond_first_order(x, f, f0, v0)
-        else:
-            eps = kernel_error(str(knobs.get("stolt_kernel", "sinc16")),
-                               0.5 / float(knobs.get("stolt_oversample", 2.0)))
+        eps = kernel_error(str(knobs.get("stolt_kernel", "sinc16")), 0.5 / float(knobs.get("stolt_oversample", 2.0)))
         return dphi + zero, amp, eps
     if algorithm == "backprojection":
         up = int(knobs.get("upsample", 8))
@@ -462,11 +466,7 @@ def predicted_cost(algorithm: str, knobs: dict[str, Any], geom: Geometry) -> flo
     if algorithm == "csa":
         return COST_CSA
     if algorithm == "omegak":
-        if knobs.get("stolt", "full") == "monochromatic":
-            return COST_OMEGAK_MONO
-        from sarcli.focus.interp import parse_interpolator
-
-        return COST_OMEGAK_MONO + COST_OMEGAK_PER_TAP * parse_interpolator(str(knobs.get("stolt_kernel", "sinc16")))[1]
+        return COST_OMEGAK_MONO if knobs.get("stolt", "full") == "monochromatic" else COST_OMEGAK_FULL
     if algorithm == "backprojection":
         return COST_BP * geom.aperture_lines / log_n
     if algorithm == "ffbp":
