@@ -8,7 +8,7 @@ R0 (1 / cos(theta) - 1)); the model's prediction is still given for it.
 
 For every registered focuser with an entry in :data:`sarcli.focus.select.KNOB_SETTINGS` (each knob
 setting on the ``KNOB_SCENES``, the focuser's own defaults elsewhere; whole-image ``ffbp`` up to
-``TIME_DOMAIN_MAX_SAMPLES``): against exact backprojection of the same lines on a 64 x 64 window around each target
+``TIME_DOMAIN_MAX_SAMPLES``, 0.6 M): against exact backprojection of the same lines on a 64 x 64 window around each target
 (:func:`bench.family.exact_chip`), range/azimuth IRW (ratio - 1), PSLR and ISLR (dB difference), peak
 phase (rad) and position (pixels); the exact IRW against window theory; time as a ratio to two
 ``scipy.fft.fft2`` of the same raw block (complex64) in the same run (interleaved, best of 2; time-domain
@@ -53,7 +53,7 @@ MAX_SAMPLES = 5_000_000
 #: ffbp are registered)
 KNOB_SCENES = ("C spaceborne 5 deg B=30 MHz", "X airborne 10 deg B=500 MHz")
 #: whole-image time-domain focusers (ffbp) only on scenes up to this many samples (time)
-TIME_DOMAIN_MAX_SAMPLES = 2_000_000
+TIME_DOMAIN_MAX_SAMPLES = 600_000
 SQUINTS = (0.0, 5.0, 10.0, 20.0, 30.0, 40.0)
 WINDOWS = {"range_window": "kaiser:2.5", "azimuth_window": "kaiser:2.5"}
 
