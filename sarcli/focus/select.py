@@ -517,12 +517,18 @@ class Selection:
                 "alternatives": [c for c in self.candidates if not c.get("chosen")], "skipped": self.skipped}
 
     def refusal(self) -> str:
-        """The one-line reason nothing was chosen."""
-        best = min(self.candidates, key=lambda c: (c["predicted"]["phase_rad"], c["cost"]), default=None)
+        """The one-line reason nothing was chosen: the fastest candidate that meets the quality (too
+        slow), else the most accurate one."""
         g = self.geometry
         msg = (f"no registered focuser meets the quality (IRW {self.quality.irw:g}, PSLR {self.quality.pslr_db:g} dB, "
                f"phase {self.quality.phase_rad:g} rad) within {self.quality.max_seconds:g} s on this geometry "
                f"(squint {g.squint_deg:.1f} deg, {g.carrier_hz / 1e9:.2f} GHz, B/f0 {g.relative_bandwidth:.3f})")
+        meeting = [c for c in self.candidates if c["meets_quality"]]
+        if meeting:
+            c = min(meeting, key=lambda c: c["seconds"])
+            return msg + (f"; the fastest that meets it, {c['algorithm']}, is predicted to take about "
+                          f"{c['seconds']:.3g} s: raise time= in --quality, or choose it with --algorithm")
+        best = min(self.candidates, key=lambda c: (c["predicted"]["phase_rad"], c["cost"]), default=None)
         if best is not None:
             p = best["predicted"]
             msg += (f"; the most accurate, {best['algorithm']}, predicts phase {p['phase_rad']:.2g} rad, IRW "
