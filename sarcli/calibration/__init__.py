@@ -15,7 +15,11 @@ Modules, one job each:
 - ``plots``       one IRF picture per reflector (range and azimuth cuts, 2-D dB chip with the measured
                   and predicted positions);
 - ``pointing``    the Doppler centroid measured on raw data against the one predicted from orbit +
-                  attitude (antenna pointing), with the standard error of the measurement.
+                  attitude (antenna pointing), with the standard error of the measurement;
+- ``radiometry``  the radiometric model of a focused image (processing gain, antenna patterns, range
+                  spreading, absolute constant K): beta0/sigma0/gamma0 look-up tables, the noise floor,
+                  point-target RCS by integrated energy, the trihedral's theoretical RCS;
+- ``products``    calibrated backscatter images (beta0, sigma0, gamma0 terrain-flattened over a DEM).
 
-The command-level step is ``sarcli.workflows.corner_reflectors``.
+The command-level steps are ``sarcli.workflows.corner_reflectors`` and ``sarcli.workflows.calibrate``.
 """

@@ -8,6 +8,12 @@ metres (``(col_meas - col_pred) dr``), azimuth in metres along track on the grou
 (``(row_meas - row_pred) ds``, ds from ``predict``). IRWs in the same metres; the theoretical IRWs
 from ``irf.theory`` (range: slant metres; azimuth: seconds x the ground speed ds / dt at the
 reflector). The acquisition time is the image's mid zero-Doppler time.
+
+Radiometry (a product with a radiometric calibration, :mod:`sarcli.calibration.radiometry`): the
+reflector's RCS by integrated energy (:func:`~sarcli.calibration.radiometry.point_rcs`) against the
+theoretical RCS of a triangular trihedral of its side seen from the radar's line of sight at the zero-Doppler
+time (:func:`~sarcli.calibration.radiometry.reflector_rcs`: 4 pi a^4 / (3 lam^2) on its boresight, the
+trihedral's pattern off it); ``rcs_error_db`` = measured - theory (dB), what ``sarcli calibrate`` removes.
 """
 
 from __future__ import annotations
@@ -24,7 +30,8 @@ from sarcli.model.slc import SLC
 
 #: the keys of one reflector's record (``sarcli quality --corner-reflectors --json``), in this order
 RECORD_KEYS = ("id", "range_offset_m", "azimuth_offset_m", "range_irw_m", "azimuth_irw_m", "range_pslr_db",
-               "azimuth_pslr_db", "range_islr_db", "azimuth_islr_db")
+               "azimuth_pslr_db", "range_islr_db", "azimuth_islr_db", "rcs_dbsm", "rcs_theory_dbsm",
+               "rcs_error_db")
 
 
 @dataclass
@@ -57,6 +64,9 @@ class ReflectorResult:
     validity: int
     plate_motion_m: float
     corrections: dict = field(default_factory=dict)
+    rcs_dbsm: float = float("nan")
+    rcs_theory_dbsm: float = float("nan")
+    rcs_error_db: float = float("nan")
 
     def record(self) -> dict:
         """Exactly :data:`RECORD_KEYS` (the JSON object of ``--json``)."""
@@ -118,6 +128,7 @@ def analyse(slc: SLC, reflectors: list[CornerReflector], search: int = 8, wet_ze
         corr = corrections(cr.latitude_deg, cr.height_m, pred.incidence_deg, slc.radar.carrier_frequency_hz,
                            pred.slant_range_m, float(np.linalg.norm(sv.interpolate(
                                np.array([pred.zero_doppler_time_s]))[1])))
+        rcs = _rcs(slc, sv, cr, p, m, pred.zero_doppler_time_s, notes)
         results.append(ReflectorResult(
             id=cr.id, range_offset_m=d_col * dr, azimuth_offset_m=d_row * ds,
             range_irw_m=m["irw_range_px"] * dr, azimuth_irw_m=m["irw_azimuth_px"] * ds,
@@ -128,5 +139,26 @@ def analyse(slc: SLC, reflectors: list[CornerReflector], search: int = 8, wet_ze
             measured_row=m["row"], measured_col=m["col"], zero_doppler_time_s=pred.zero_doppler_time_s,
             slant_range_m=pred.slant_range_m, along_track_spacing_m=ds, incidence_deg=pred.incidence_deg,
             peak_amplitude=m["peak_amplitude"], survey_utc=cr.survey_utc, validity=cr.validity,
-            plate_motion_m=motion, corrections=corr))
+            plate_motion_m=motion, corrections=corr, **rcs))
     return Analysis(acq, results, outside, th_r, th_a, notes)
+
+
+def _rcs(slc: SLC, sv, cr: CornerReflector, p: np.ndarray, m: dict, t_zd: float, notes: list[str]) -> dict:
+    """rcs_dbsm, rcs_theory_dbsm, rcs_error_db of one reflector (NaN, with a note, when not measurable)."""
+    from sarcli.calibration.radiometry import point_rcs, reflector_rcs
+
+    pos = sv.interpolate(np.array([t_zd]))[0][0]
+    theory = reflector_rcs(cr, p, pos, slc.radar.wavelength_m)
+    out = {"rcs_theory_dbsm": 10.0 * np.log10(theory) if theory > 0 else float("-inf")}
+    if slc.calibration is None:
+        if not any(n.startswith("radiometry:") for n in notes):
+            notes.append("radiometry: the product carries no radiometric calibration: no RCS measured")
+        return out
+    try:
+        rcs = point_rcs(slc, m["row"], m["col"])
+    except SarcliError as e:
+        notes.append(f"{cr.id}: RCS not measured ({e})")
+        return out
+    out["rcs_dbsm"] = 10.0 * np.log10(rcs) if rcs > 0 else float("nan")
+    out["rcs_error_db"] = out["rcs_dbsm"] - out["rcs_theory_dbsm"]
+    return out

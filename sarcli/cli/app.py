@@ -24,6 +24,8 @@ from sarcli.cli.common import SarcliGroup, make_typer, terminal
 COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
     "batch": (("batch",), "Process a folder of scenes: raw -> Doppler -> SLC + GeoTIFF + quicklook, as one "
                           "task graph."),
+    "calibrate": (("calibrate",), "Derive the absolute calibration constant K from corner reflectors and write "
+                  "it into the SLC."),
     "design": (("design",), "Derive resolutions, PRF window, Doppler samples and swath, and check each "
                             "constraint."),
     "doppler": (("doppler",), "Estimate the Doppler centroid (baseband CDE + ambiguity) and the Doppler rate."),

@@ -16,6 +16,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import scipy.fft as sfft
@@ -27,6 +28,7 @@ from sarcli.focus.geolocation import platform_state, zero_doppler_points
 from sarcli.focus.rangecomp import C, compress_lines, range_filter, reference_pulse
 from sarcli.focus.rda import OutputGrid, doppler_on_grid, plan_grid
 from sarcli.focus.windows import parse_window
+from sarcli.gpu.device import check_device
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import Terrain
@@ -37,7 +39,10 @@ class BpOptions:
     """Backprojection knobs: windows, bands and replica as the RDA (:class:`sarcli.focus.rda.RdOptions`);
     ``upsample``: range Fourier upsampling before the linear interpolation of each line;
     ``lines``/``samples``: the output window [a, b) of the RD grid (default: all of it);
-    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once)."""
+    ``block_lines``: output lines per block (memory: the block's raw lines are range-compressed at once);
+    ``precision``: single (float32 phasor-recurrence kernel) | double (the complex128 reference kernel)
+    (:mod:`sarcli.focus.backprojection`); ``device``: cpu, or cuda (the backprojection kernel on the GPU,
+    :mod:`sarcli.gpu.bp_cuda`)."""
 
     range_window: str = "kaiser:2.5"
     range_bandwidth_fraction: float = 1.0
@@ -49,12 +54,17 @@ class BpOptions:
     samples: tuple[int, int] | None = None
     block_lines: int = 4096
     workers: int = -1
+    precision: Literal["single", "double"] = "single"
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
         parse_window(self.range_window)
         parse_window(self.azimuth_window)
         if not 1 <= self.upsample <= 64:
             raise ConfigError(f"upsample must be 1..64, got {self.upsample}")
+        if self.precision not in ("single", "double"):
+            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
         if self.block_lines < 1:
             raise ConfigError(f"block_lines must be positive, got {self.block_lines}")
         if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
@@ -115,10 +125,8 @@ class Backprojection:
         raw, g, k = plan.raw, plan.grid, plan.options
         la, _, sa, sb = plan.window
         s, e = plan.block_rows(b)
-        n_lines = raw.azimuth_time.size
         nr = g.ranges.size
-        # output line j sees raw lines j + offset - shift +- aperture / 2: the RD overlap covers them
-        a, z = max(0, la + s - g.pad), min(n_lines, la + e + g.pad)
+        a, z = self.raw_span(plan, b)
         t0 = time.perf_counter()
         data = np.asarray(read_lines(a, z))
         if data.shape != (z - a, nr):
@@ -133,11 +141,25 @@ class Backprojection:
         pix = zero_doppler_points(raw.orbit, raw.epoch_utc, tt, rr, g.wavelength, raw.look_side, plan.terrain)
         pos, vel = platform_state(raw.orbit, raw.epoch_utc, raw.azimuth_time[a:z])
         fdc_pix = np.broadcast_to(plan.fdc[sa:sb][None, :], tt.shape).ravel()
-        img = backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
-                               pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
-                               k.upsample).reshape(tt.shape)
+        img = self.image(plan, rc, a, pos, vel, pix, rr, fdc_pix)
         plan.timings["backprojection_s"] = plan.timings.get("backprojection_s", 0.0) + time.perf_counter() - t0
         return img.astype(np.complex64)
+
+    def raw_span(self, plan: BpPlan, b: int) -> tuple[int, int]:
+        """Raw lines [a, z) that block ``b`` reads: output line j sees raw lines j + offset - shift +-
+        aperture / 2, which the RD overlap covers."""
+        la, s, e, pad = plan.window[0], *plan.block_rows(b), plan.grid.pad
+        return max(0, la + s - pad), min(plan.raw.azimuth_time.size, la + e + pad)
+
+    def image(self, plan: BpPlan, rc: np.ndarray, a: int, pos: np.ndarray, vel: np.ndarray, pix: np.ndarray,
+              rr: np.ndarray, fdc_pix: np.ndarray) -> np.ndarray:
+        """The block's image from its range-compressed lines ``rc`` (raw lines from ``a``; positions and
+        velocities ``pos``, ``vel``) at the pixels ``pix`` (lines, samples, 3) of ranges ``rr``, centroids
+        ``fdc_pix`` (flat)."""
+        raw, g, k = plan.raw, plan.grid, plan.options
+        return backproject_grid(rc, raw.radar.first_range_m, C / (2 * raw.radar.range_sampling_rate_hz), g.wavelength,
+                                pos, vel, pix.reshape(-1, 3), rr.ravel(), fdc_pix, g.ba, k.azimuth_window,
+                                k.upsample, k.precision, first_line=a, device=k.device).reshape(rr.shape)
 
     def finish(self, plan: BpPlan) -> SLC:
         raw, g = plan.raw, plan.grid

@@ -120,7 +120,7 @@ def slc_tags(slc: SLC, inputs: tuple = (), extra: dict | None = None) -> dict[st
         **(extra or {}))
 
 
-def _amplitude_bands(amp, inten: np.ndarray, full: np.ndarray, geometry: str):
+def _amplitude_bands(amp, inten: np.ndarray, full: np.ndarray, geometry: str, radiometry: str | None = None):
     """The two bands of an amplitude GeoTIFF from ``amp`` (array or Strips): the amplitude and its dB,
     and the QGIS style of the dB band, stretched over the fully focused rows of the intensity ``inten``
     (the multilooked image the amplitude is resampled from: the same distribution, held anyway), taken
@@ -132,6 +132,11 @@ def _amplitude_bands(amp, inten: np.ndarray, full: np.ndarray, geometry: str):
     step = max(1, int(np.ceil(np.sqrt(rows.size * inten.shape[1] / STRETCH_SAMPLES))))
     with np.errstate(divide="ignore"):
         lo, hi = db_stretch(10.0 * np.log10(inten[rows[::step], ::step].astype(np.float64)))
+    if radiometry:  # the intensity is calibrated backscatter (sarcli.calibration.products)
+        return ([Band(amp, f"sqrt({radiometry}), calibrated amplitude, {geometry}", "1", "power"),
+                 Band(amp, f"{radiometry} 10 log10, {geometry}", "dB", "power_db",
+                      derive=lambda a: amplitude_db(a, floor_db=None))],
+                Style(2, lo, hi, "gray", f"{radiometry} (dB)"))
     return ([Band(amp, f"amplitude, {geometry}", "1", "power"),
              Band(amp, f"amplitude 20 log10|z|, {geometry}", "dB", "power_db",
                   derive=lambda a: amplitude_db(a, floor_db=None))],
@@ -188,11 +193,13 @@ def utm_epsg(lat_deg: float, lon_deg: float) -> int:
 
 def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, tags: dict | None = None,
                         terrain: Terrain | None = None, inputs: tuple = (),
-                        intensity: np.ndarray | None = None, compression: str = "deflate") -> None:
+                        intensity: np.ndarray | None = None, compression: str = "deflate",
+                        radiometry: str | None = None) -> None:
     """Amplitude in slant-range geometry with a lat/lon GCP grid (EPSG:4326) on ``terrain`` (default 0 m);
     ``tags``: extra tags beside :func:`slc_tags`; ``inputs``: the files it was made from (the SLC).
     ``intensity``: ``multilook(slc.image, looks_az, looks_rg)`` when the caller has it (then ``slc``
-    needs no image); ``compression``: ``sarcli.io.images.COMPRESSIONS``."""
+    needs no image); ``compression``: ``sarcli.io.images.COMPRESSIONS``; ``radiometry``: as in
+    :func:`write_map_geotiff`."""
     from sarcli.io.images import Strips, write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
@@ -206,7 +213,7 @@ def write_slant_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, ta
             yield a, amp
 
     bands, style = _amplitude_bands(Strips(inten.shape, strips), inten, full,
-                                    "slant-range geometry (lines: zero-Doppler time)")
+                                    "slant-range geometry (lines: zero-Doppler time)", radiometry)
     write_geotiff(path, bands, 4326, gcps=gcps, tags=slc_tags(slc, inputs, tags), style=style,
                   compression=compression)
 
@@ -570,15 +577,18 @@ def amplitude_numpy(inten: np.ndarray, full: np.ndarray, r: np.ndarray, c: np.nd
 
 def write_map_geotiff(path, slc: SLC, looks_az: int = 1, looks_rg: int = 1, crs: str | None = None,
                       spacing_m: float | None = None, tags: dict | None = None, terrain: Terrain | None = None,
-                      inputs: tuple = (), intensity: np.ndarray | None = None, compression: str = "deflate") -> str:
+                      inputs: tuple = (), intensity: np.ndarray | None = None, compression: str = "deflate",
+                      radiometry: str | None = None) -> str:
     """Map-projected amplitude COG (NaN nodata; module docstring); returns the CRS used.
-    ``intensity`` and ``compression``: as in :func:`write_slant_geotiff`."""
+    ``intensity`` and ``compression``: as in :func:`write_slant_geotiff`; ``radiometry``: the intensity is
+    that calibrated backscatter (beta0, sigma0, gamma0: :mod:`sarcli.calibration.products`), the bands
+    are labelled so."""
     from sarcli.io.images import write_geotiff
 
     inten = multilook(slc.image, looks_az, looks_rg) if intensity is None else intensity
     amp, transform, crs = map_strips(slc, looks_az, looks_rg, crs, spacing_m, terrain, intensity=inten)
     bands, style = _amplitude_bands(amp, inten, full_rows(slc, inten.shape[0], looks_az),
-                                    "map projected (bilinear intensity resampling)")
+                                    "map projected (bilinear intensity resampling)", radiometry)
     write_geotiff(path, bands, crs, transform=transform, tags=slc_tags(slc, inputs, tags), style=style,
                   compression=compression)
     return crs

@@ -48,7 +48,7 @@ Residual phase per algorithm (target at R0, reference range R_ref = mid-swath, V
   alike to 1e-4 rad at 0-40 deg).
 - ``backprojection``: exact (the sum over pulses along the true track); the linear interpolation of
   range lines upsampled U times weights the range band by sinc^2(x / (U fs)).
-- ``ffbp`` [Ulander2003] (knobs of ``sarcli.focus.ffbp``: ``base`` pulses per subaperture and merge,
+- ``ffbp`` [UlaHelSte2003] (knobs of ``sarcli.focus.ffbp``: ``base`` pulses per subaperture and merge,
   angular ``oversample`` beta, ``order`` / ``range_order`` interpolation taps): no systematic phase;
   each of the S merge stages and the last one interpolates once in angle and once in range, with the
   error of interpolating exp(j 2 pi nu x), |nu| <= 1/(2 beta): (pi / beta)^2 / 8 for linear, 1 /
@@ -96,7 +96,7 @@ KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
 #: predicted cost, in units of two ``scipy.fft.fft2`` of the raw block (n_lines x n_samples, complex64),
 #: per algorithm. ``rd`` and ``backprojection``: measured by bench/bench_focus_family.py (see
 #: docs/focusing.md); the others are operation counts relative to the RDA [CumWong2005, sec. 7.7,
-#: 8.5; Ulander2003, sec. IV] until the map measures them after they are registered.
+#: 8.5; UlaHelSte2003, sec. IV] until the map measures them after they are registered.
 COST_RD = 3.2  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.2-7.7 on a loaded machine)
 # csa and omegak: their own benchmarks' ratio to rd on the same 1536 x 2048 block in the same run
 # (bench_csa: 1.28; bench_omegak: monochromatic 1.58, full Stolt 5.4 with sinc8 or sinc16: its longer
@@ -276,7 +276,7 @@ def kernel_error(name: str, band_fraction: float) -> float:
 
 def ffbp_kernel_error(taps: int, oversample: float) -> float:
     """The largest error of interpolating exp(j 2 pi nu x), |nu| <= 1 / (2 beta), with FFBP's kernels
-    [Ulander2003; Knab's prolate-windowed sinc]: (pi / beta)^2 / 8 for 2 taps (linear), 1 / cosh(pi v N
+    [UlaHelSte2003; Knab's prolate-windowed sinc]: (pi / beta)^2 / 8 for 2 taps (linear), 1 / cosh(pi v N
     / 2) with v = 1 - 1 / beta for N >= 4 taps."""
     if taps <= 2:
         return (math.pi / oversample) ** 2 / 8.0
@@ -298,7 +298,7 @@ FFBP_BOUND_FRACTION = 0.05
 def ffbp_floor(n_aperture: float, knobs: dict[str, Any], range_oversample: float = 2.0) -> float:
     """FFBP_BOUND_FRACTION x the bound (S + 1) (e_order(beta) + e_range_order(U)): every merge and the
     last stage interpolate once in angle (``order`` taps at the angular oversampling beta) and in range
-    (``range_order`` taps at U = ``range_oversample``), coherent at a scatterer's peak [Ulander2003]
+    (``range_order`` taps at U = ``range_oversample``), coherent at a scatterer's peak [UlaHelSte2003]
     (module docstring)."""
     base = int(knobs.get("base", 4))
     s = ffbp_stages(n_aperture, base)

@@ -1,5 +1,6 @@
 """Focus a GB-SAR scan onto a Cartesian slant-plane grid with DF, RD, BP or ``auto`` (DF far, near
-algorithm nearer, split at the DF minimum range of eq. 12).
+algorithm nearer, split at the DF minimum range of eq. 12), or FFBP (:mod:`sarcli.gbsar.ffbp`: BP's
+images by fast factorized backprojection, on BP's grids; code 3 in ``algorithm_map``, as BP).
 
 Grid: rows are range R0 from the rail line on the range-compression bins ``n c/(2 N_Rfft df)`` up to
 ``max_range`` (default R_max), columns are azimuth x on the lattice ``x_0 + j*k*dx`` of the rail stops
@@ -29,17 +30,20 @@ from typing import Literal
 import numpy as np
 
 from sarcli.errors import ConfigError, ProductError, SarcliError
+from sarcli.focus.ffbp import FfbpKnobs
 from sarcli.gbsar.backprojection import backproject, backproject_grid
 from sarcli.gbsar.deramp import aperture_gain, focus_df, geometric_correction
+from sarcli.gbsar.ffbp import ffbp_grid, ffbp_slant
 from sarcli.gbsar.rail import ordered
 from sarcli.gbsar.rangecomp import RangeProfiles, check_sweep, range_compress, wave_speed
 from sarcli.gbsar.rangedoppler import focus_rd_pols, rd_n_xfft
 from sarcli.gbsar.system import df_min_range, df_phase_error, next_pow2
 from sarcli.gbsar.windows import parse_taper
+from sarcli.gpu.device import check_device
 from sarcli.model.gbsar import Scan
 
-ALGORITHMS = ("auto", "df", "rd", "bp")
-ALG_CODE = {"df": 1, "rd": 2, "bp": 3}
+ALGORITHMS = ("auto", "df", "rd", "bp", "ffbp")
+ALG_CODE = {"df": 1, "rd": 2, "bp": 3, "ffbp": 3}
 
 
 @dataclass
@@ -99,10 +103,15 @@ class FocusOptions:
     ``beam_limited``: BP integrates each pixel's beam footprint only; ``rd_reference``: sinc | rect;
     ``grid_m``: (x0, x1, dx, y0, y1, dy[, z]) backprojects onto that horizontal grid instead (module
     docstring; ``auto`` means BP there, and the slant-grid options must stay unset);
-    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1).
+    ``permittivity``: relative permittivity of the medium the waves travel in (>= 1); ``ffbp``: the
+    knobs of ``algorithm`` ffbp (:class:`sarcli.focus.ffbp.FfbpKnobs`; aperture_split 64: a rail's footprint
+    apertures are short, so most of them are backprojected stop by stop, as BP does);
+    ``bp_precision``: single | double, the grid backprojection kernel (float32 phasor recurrence or float64);
+    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU
+    (:mod:`sarcli.gpu.bp_cuda`; DF and RD stay on the CPU).
     """
 
-    algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
+    algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
     range_window: str = "hamming"
     azimuth_window: str = "hamming"
     max_range_m: float | None = None
@@ -119,8 +128,15 @@ class FocusOptions:
     rd_reference: Literal["sinc", "rect"] = "sinc"
     grid_m: tuple[float, ...] = ()
     permittivity: float = 1.0
+    ffbp: FfbpKnobs = FfbpKnobs(aperture_split=64)
+    bp_precision: Literal["single", "double"] = "single"
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
+        if self.device == "cuda" and self.algorithm == "ffbp":
+            raise ConfigError("ffbp runs on the CPU only (no CUDA kernels for its merge stages yet): use --device "
+                              "cpu, or --algorithm bp --device cuda")
         if self.algorithm not in ALGORITHMS:
             raise ConfigError(f"unknown algorithm '{self.algorithm}' (use {', '.join(ALGORITHMS)})")
         if self.near not in ("rd", "bp"):
@@ -143,10 +159,13 @@ class FocusOptions:
                 raise ConfigError(f"{name} must be >= 1, got {getattr(self, name)}")
         if not (math.isfinite(self.permittivity) and self.permittivity >= 1.0):
             raise ConfigError(f"--permittivity must be a relative permittivity >= 1, got {self.permittivity:g}")
+        if self.bp_precision not in ("single", "double"):
+            raise ConfigError(f"bp_precision must be 'single' or 'double', not '{self.bp_precision}'")
         if self.grid_m:
             self.plane_grid()
-            if self.algorithm not in ("bp", "auto"):
-                raise ConfigError(f"--grid is a backprojection grid: use --algorithm bp, not {self.algorithm}")
+            if self.algorithm not in ("bp", "ffbp", "auto"):
+                raise ConfigError(f"--grid is a backprojection grid: use --algorithm bp, not {self.algorithm} "
+                                  "(or ffbp)")
             slant = [flag for flag, value in (("--max-range", self.max_range_m), ("--pixel-x", self.pixel_x_m),
                                               ("--width", self.width_m), ("--n-xfft", self.n_xfft))
                      if value is not None] + (["--min-range"] if self.min_range_m else [])
@@ -224,7 +243,14 @@ def _bp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) 
     prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
     return backproject(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
-                       opts.azimuth_window)
+                       opts.azimuth_window, opts.device)
+
+
+def _ffbp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> np.ndarray:
+    prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
+    px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
+    return ffbp_slant(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
+                      opts.azimuth_window, opts.ffbp)
 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
@@ -320,6 +346,8 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
         for ip, pol in enumerate(pols):
             if name == "bp":
                 part, cov = _bp(scan, pol, grid, rows, opts), np.ones((rows.size, grid.azimuths.size), bool)
+            elif name == "ffbp":
+                part, cov = _ffbp(scan, pol, grid, rows, opts), np.ones((rows.size, grid.azimuths.size), bool)
             elif name == "df":
                 part, cov, n_xfft_used["df"] = _df(scan, pol, grid, rows, opts)
             else:
@@ -388,20 +416,25 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
                               centred=True)
         if np.all(prof.weights == 0):
             raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
-        image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
-                                           opts.azimuth_window)
+        if opts.algorithm == "ffbp":
+            image[ip], frac = ffbp_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
+                                        opts.azimuth_window, opts.ffbp)
+        else:
+            image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
+                                               opts.azimuth_window, opts.bp_precision, opts.device)
     amap = np.where(frac > 0, ALG_CODE["bp"], 0).astype(np.uint8)
+    used = "ffbp" if opts.algorithm == "ffbp" else "bp"
     report = {
-        "algorithm": opts.algorithm, "used": {"bp": [float(plane.ys[0]), float(plane.ys[-1])]},
+        "algorithm": opts.algorithm, "used": {used: [float(plane.ys[0]), float(plane.ys[-1])]},
         "grid": {"x_m": [float(plane.xs[0]), float(plane.xs[-1])], "y_m": [float(plane.ys[0]), float(plane.ys[-1])],
                  "dx_m": float(opts.grid_m[2]), "dy_m": float(opts.grid_m[5]), "z_m": plane.z},
         "n_sweeps": scan.n_stops, "track": "rail" if scan.antenna_position is None else "3-D",
         "reference_range": scan.reference_range is not None,
         "unambiguous_range_m": [float(prof.first_range_m), float(-prof.first_range_m)],
         "full_aperture_fraction": float(np.mean(frac >= 1.0 - 1e-9)),
-        "skipped_stops": list(prof.skipped), "seconds": {"bp": time.perf_counter() - t0},
+        "skipped_stops": list(prof.skipped), "seconds": {used: time.perf_counter() - t0},
         "polarizations": list(pols), "range_window": opts.range_window, "azimuth_window": opts.azimuth_window,
-        "footprint_antenna_length_m": None, "permittivity": opts.permittivity,
+        "footprint_antenna_length_m": None, "permittivity": opts.permittivity, "bp_precision": opts.bp_precision,
     }
     return Focused(image=image, grid=Grid(ranges=plane.ys, azimuths=plane.xs), algorithm_map=amap, report=report)
 

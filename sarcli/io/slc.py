@@ -19,6 +19,12 @@ Layout (SI units)::
     /geolocation_grid      Earth orbits only: longitude, latitude, incidence_angle, look_angle (degrees) on
                            (height, azimuth_time, slant_range) nodes; root ``bounding_polygon`` (WKT)
     /truth                 copied from a simulated raw product (``sarcli quality`` compares with it)
+    /calibration           radiometric LUTs (:class:`sarcli.model.slc.Calibration`,
+                           :mod:`sarcli.calibration.radiometry`) on nodes azimuth_time x slant_range:
+                           beta0, sigma0, gamma0 (multiplicative: beta0 = |DN|^2 * beta0), nes0 (noise-
+                           equivalent sigma0, linear); attributes constant (K), applied / not_applied
+                           (JSON lists of the model's terms), details (JSON); nes0_per_sample
+                           (n_samples,) the noise floor of every column (on /slant_range)
     /timings               attributes: seconds per processing stage
 
 Times are ``seconds since <epoch_utc>`` (CF); /image's axes are the dimension scales /azimuth_time and
@@ -56,7 +62,7 @@ from sarcli.io.h5common import (
 from sarcli.io.raw import read_platform, read_radar, write_platform, write_radar
 from sarcli.model import checks as ck
 from sarcli.model.raw import LOOK_SIDES
-from sarcli.model.slc import SLC, DopplerUsed
+from sarcli.model.slc import SLC, Calibration, DopplerUsed
 
 PRODUCT_TYPE = "slc"
 SCHEMA_VERSION = "1"
@@ -150,9 +156,55 @@ def _write_meta(f: h5py.File, s: SLC, image: h5py.Dataset) -> None:
     _write_geolocation(f, s, tunits)
     if s.truth is not None:
         write_mapping(f, "truth", s.truth, s.epoch_utc)
+    if s.calibration is not None:
+        write_calibration(f, s.calibration, tunits, np.asarray(s.slant_range, np.float64))
     tg = group(f, "timings")
     for k, v in sorted(s.timings.items()):
         tg.attrs[k] = float(v)
+
+
+def write_calibration(f: h5py.Group, cal: Calibration, tunits: str, slant_range: np.ndarray | None = None) -> None:
+    """The /calibration group (module docstring), replacing one that is there; with the image's
+    ``slant_range`` also ``nes0_per_sample``: the noise floor at every column (the nodes' mean over
+    time, linear in range between nodes)."""
+    if "calibration" in f:
+        del f["calibration"]
+    g = group(f, "calibration")
+    g.attrs["description"] = ("radiometric look-up tables: X = |DN|^2 * X for X in beta0, sigma0, gamma0 "
+                              "(bilinear between nodes; NaN: not calibrated); nes0 the noise-equivalent sigma0")
+    g.attrs["constant"] = float(cal.constant)
+    g.attrs["applied"] = json.dumps(list(cal.applied))
+    g.attrs["not_applied"] = json.dumps(list(cal.not_applied))
+    g.attrs["details"] = json.dumps(to_jsonable(dict(cal.details)), sort_keys=True)
+    t = coordinate(g, "azimuth_time", np.asarray(cal.azimuth_time, np.float64), tunits,
+                   "zero-Doppler time of the nodes")
+    r = coordinate(g, "slant_range", np.asarray(cal.slant_range, np.float64), "m", "slant range of the nodes")
+    for name, desc in (("beta0", "beta0 per |DN|^2"), ("sigma0", "sigma0 per |DN|^2 (ellipsoid incidence)"),
+                       ("gamma0", "gamma0 per |DN|^2 (ellipsoid incidence)"),
+                       ("nes0", "noise-equivalent sigma0 (linear)")):
+        dataset(g, name, np.asarray(getattr(cal, name), np.float64), units="1", description=desc, dims=(t, r))
+    if slant_range is not None and "slant_range" in f:
+        with np.errstate(invalid="ignore"):
+            per = np.interp(slant_range, cal.slant_range, np.mean(cal.nes0, axis=0))
+        ds = dataset(g, "nes0_per_sample", per, units="1",
+                     description="noise-equivalent sigma0 (linear) of every image column, mean over time")
+        ds.dims[0].attach_scale(f["slant_range"])
+
+
+def read_calibration(g: h5py.Group, path) -> Calibration:
+    """Inverse of :func:`write_calibration` (one ProductError line on a malformed group)."""
+    t = read_array(g, "azimuth_time", "f", ndim=1, min_size=1)
+    r = read_array(g, "slant_range", "f", ndim=1, min_size=1)
+    luts = [read_array(g, k, "f", shape=(t.size, r.size), finite=False) for k in ("beta0", "sigma0", "gamma0",
+                                                                                  "nes0")]
+    try:
+        applied = tuple(json.loads(attr_str(g, "applied", "[]")))
+        missing = tuple(json.loads(attr_str(g, "not_applied", "[]")))
+        details = json.loads(attr_str(g, "details", "{}"))
+    except ValueError:
+        raise ProductError(f"{path}: calibration attributes are not valid JSON") from None
+    return Calibration(t, r, *luts, constant=attr_number(g, "constant", lo=0.0), applied=applied,
+                       not_applied=missing, details=details)
 
 
 #: bytes of one ``/image`` chunk at most (HDF5's default chunk cache is 1 MiB: a chunk that a block
@@ -239,6 +291,7 @@ def read_slc(path: str | os.PathLike, load_image: bool = True) -> SLC:
             if part is not None:
                 part.validate(where)
         truth = read_mapping(f["truth"]) if "truth" in f else None
+        calibration = read_calibration(f["calibration"], path) if "calibration" in f else None
         timings = {}
         if "timings" in f:
             timings = {k: attr_number(f["timings"], k) for k in f["timings"].attrs}
@@ -252,7 +305,7 @@ def read_slc(path: str | os.PathLike, load_image: bool = True) -> SLC:
             first_full_line=attr_number(f, "first_full_line", 0, integer=True),
             last_full_line=attr_number(f, "last_full_line", n - 1, integer=True),
             parameters=attr_json(f, "parameters", {}), timings=timings,
-            orbit=orbit, attitude=attitude, truth=truth,
+            orbit=orbit, attitude=attitude, truth=truth, calibration=calibration,
         )
         if load_image:
             slc.image = ck.array(where, "image", img[()], "c")

@@ -54,6 +54,14 @@ class Radar:
     quantization_bits: int = 0
     receiver_offsets_m: tuple[float, ...] = (0.0,)
     platform_velocity_mps: float | None = None
+    #: the antenna, when the product knows it (radiometry, :mod:`sarcli.calibration.radiometry`): azimuth
+    #: length and elevation height (m) of a uniformly illuminated aperture (0: uniform illumination, the
+    #: pattern of a zero-size aperture), boresight look angle off the geodetic nadir (rad)
+    antenna_length_m: float | None = None
+    antenna_height_m: float | None = None
+    antenna_look_angle_rad: float | None = None
+    #: receiver noise E|n|^2 per complex echo sample (echo units), when the product states it
+    noise_power: float | None = None
 
     def validate(self, where: str = "radar", n_samples: int | None = None) -> None:
         """Refuse (one :class:`ProductError` line) a missing, mistyped or physically implausible parameter.

@@ -27,6 +27,28 @@ class DopplerUsed:
 
 
 @dataclass
+class Calibration:
+    """Radiometric look-up tables of an SLC on a coarse (zero-Doppler time, slant range) grid
+    (:mod:`sarcli.calibration.radiometry` derives them; NISAR RSLC's convention): beta0 = |DN|^2 * beta0,
+    sigma0 = |DN|^2 * sigma0, gamma0 = |DN|^2 * gamma0 (ellipsoid incidence), all (n_t, n_r), NaN where the
+    product is not calibrated (outside the antenna's main lobe); ``nes0`` the noise-equivalent sigma0
+    (linear, NaN without a noise measurement). ``constant`` is the absolute calibration constant K
+    (|DN|^2 = K F beta0, F the modelled gain), ``applied`` / ``not_applied`` name the terms of the
+    radiometric model that were and were not applied; ``details`` the numbers behind them."""
+
+    azimuth_time: np.ndarray
+    slant_range: np.ndarray
+    beta0: np.ndarray
+    sigma0: np.ndarray
+    gamma0: np.ndarray
+    nes0: np.ndarray
+    constant: float
+    applied: tuple[str, ...]
+    not_applied: tuple[str, ...]
+    details: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
 class SLC:
     """In-memory focused image with its axes; ``image`` (n_lines, n_samples) complex64."""
 
@@ -47,6 +69,7 @@ class SLC:
     orbit: Orbit | None = None
     attitude: Attitude | None = None
     truth: dict[str, Any] | None = None
+    calibration: Calibration | None = None
 
     @classmethod
     def from_raw(cls, raw, *, image: np.ndarray, azimuth_time: np.ndarray, slant_range: np.ndarray,

@@ -124,7 +124,12 @@ def simulate(scene: Scene, dtype=np.complex64, progress: Callable[[int], None] |
         range_sampling_rate_hz=rad.range_sampling_rate_hz, chirp_rate_hz_per_s=rad.chirp_rate_hz_per_s,
         pulse_length_s=rad.pulse_length_s, window_start_s=rad.window_start_s, first_range_m=rad.first_range_m,
         quantization_bits=0, receiver_offsets_m=tuple(ctx.receiver_offsets_m),
-        platform_velocity_mps=v_mid if traj.frame == "LOCAL" else None)
+        platform_velocity_mps=v_mid if traj.frame == "LOCAL" else None,
+        # the antenna the echoes saw (radiometry): without the pattern effect the illumination is uniform,
+        # the pattern of an aperture of zero size (sinc^2(0) = 1)
+        antenna_length_m=scene.antenna.length_m if ctx.antenna_pattern else 0.0,
+        antenna_height_m=scene.antenna.height_m if ctx.antenna_pattern else 0.0,
+        antenna_look_angle_rad=scene.antenna.look_angle_rad)
     product = RawProduct(
         echo=out[0], azimuth_time=tc + traj.pulse_time, epoch_utc=scene.epoch_utc, radar=radar,
         look_side=rad.look_side, source="simulated", echo_channels=out[1:] if n_ch > 1 else None,

@@ -21,6 +21,7 @@ WORKFLOWS: Registry = Registry("workflow", "sarcli.workflows", {
     "ati_estimate": "sarcli.workflows.ati_estimate",
     "ati_montecarlo": "sarcli.workflows.ati_montecarlo",
     "batch": "sarcli.workflows.batch",
+    "calibrate": "sarcli.workflows.calibrate",
     "corner_reflectors": "sarcli.workflows.corner_reflectors",
     "design": "sarcli.workflows.design",
     "doppler": "sarcli.workflows.doppler",

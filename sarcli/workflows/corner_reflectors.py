@@ -95,7 +95,8 @@ class CornerReflectorReport(Report):
                        f"ISLR rg {r['range_islr_db']:.2f} dB, az {r['azimuth_islr_db']:.2f} dB; "
                        f"troposphere ~{c['troposphere_slant_delay_m']:.2f} m slant (incidence "
                        f"{r['incidence_deg']:.1f} deg), ionosphere "
-                       f"{c['ionosphere_slant_delay_per_tecu_m']:.3f} m per TECU")
+                       f"{c['ionosphere_slant_delay_per_tecu_m']:.3f} m per TECU; RCS {r['rcs_dbsm']:.2f} dBm2 "
+                       f"(trihedral theory {r['rcs_theory_dbsm']:.2f}, {r['rcs_error_db']:+.2f} dB)")
         if self.outside_image:
             out.append(f"outside the image: {', '.join(self.outside_image)}")
         out += [f"note: {n}" for n in self.notes]

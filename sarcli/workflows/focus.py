@@ -55,6 +55,7 @@ class Config:
     algorithm ``auto``: the cheapest registered focuser whose predicted errors on this geometry meet
     ``quality`` (``"irw=0.02,pslr=1,phase=0.1"``, :class:`sarcli.focus.select.Quality`; default those),
     chosen by :func:`sarcli.focus.select.choose_for` once the Doppler model is known, before focusing;
+    device: cpu | cuda, the focuser's ``device`` option (None: the focuser's default, cpu);
     workers / threads_per_worker / scheduler: focus the blocks in parallel on a local Dask cluster of
     that many processes, or on the scheduler at that address (:mod:`sarcli.parallel.cluster`); they
     do not change the image and are not stored in the product.
@@ -80,13 +81,18 @@ class Config:
     looks_rg: int = 1
     channel: int = 0
     accept_unresolved_ambiguity: bool = False
+    device: Literal["cpu", "cuda"] | None = None
     workers: int | None = None
     threads_per_worker: int = 1
     scheduler: str | None = None
+    radiometry: Literal["beta0", "sigma0", "gamma0"] | None = None
+    noise_subtraction: bool = False
     quality: str | None = None
 
     def __post_init__(self) -> None:
         self.cluster()  # checked when the configuration is made
+        if self.radiometry is not None and self.radiometry not in ("beta0", "sigma0", "gamma0"):
+            raise ConfigError(f"--radiometry must be beta0, sigma0 or gamma0, got {self.radiometry!r}")
         if self.quality is not None:
             if self.algorithm != "auto":
                 raise ConfigError("--quality states what --algorithm auto must meet: give --algorithm auto")
@@ -107,6 +113,8 @@ class Config:
                 raise ConfigError(f"--{name.replace('_m', '')} must be a finite number, got {v}")
         if self.channel < 0:
             raise ConfigError(f"--channel must be >= 0, got {self.channel}")
+        if self.device == "cuda" and (self.workers or self.scheduler):
+            raise ConfigError("--device cuda focuses on the GPU in this process: drop --workers/--scheduler")
         from sarcli.io.images import compression_options
 
         compression_options(self.geotiff_compression)  # one line naming the choices if unknown
@@ -213,6 +221,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     start_probing()  # the inputs' metadata probe starts while the focusers are imported
     from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, options_for, run_blocks
+    from sarcli.gpu.device import options_with_device
     from sarcli.io.atomic import all_or_nothing
 
     progress = progress or no_progress
@@ -222,7 +231,8 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         _check_outputs(config)
         auto = config.algorithm == "auto"
         focuser: Any = None if auto else FOCUSERS.get(config.algorithm)  # auto: chosen below
-        options = None if auto else options_for(focuser, config.options)
+        options = None if auto else options_for(focuser, options_with_device(focuser.Options, config.options,
+                                                                              config.device))
         from sarcli.io.dem import load_terrain
         from sarcli.io.raw import raw_shape, read_raw
 
@@ -304,7 +314,10 @@ def _auto(config: Config, raw, shape, model):
     known = {f.name for f in dc_fields(focuser.Options)}
     dropped = sorted(set(config.options) - known)
     notes = [f"auto chose {sel.algorithm}, which has no option {', '.join(dropped)}: not used"] if dropped else []
-    options = options_for(focuser, {**{k: v for k, v in config.options.items() if k in known}, **sel.knobs})
+    from sarcli.gpu.device import options_with_device
+
+    kept = {**{k: v for k, v in config.options.items() if k in known}, **sel.knobs}
+    options = options_for(focuser, options_with_device(focuser.Options, kept, config.device))
     return focuser, options, sel.to_dict(), notes
 
 
@@ -373,6 +386,9 @@ def _focus_to_file(config: Config, focuser, options, raw, shape, model, terrain,
             echo = load_echo().channel(ch) if focuser.streams else plan_raw.echo
             slc = run_blocks(focuser, plan, lambda a, b: echo[a:b], sink, on_block)
         slc.parameters = {**slc.parameters, "terrain": terrain.describe(), "config": config.stored()}
+        from sarcli.calibration.radiometry import annotate
+
+        slc.calibration = annotate(slc, load_echo.raw or raw, shape[1])
         meta.update_from(slc)
     return slc, sink
 
@@ -413,20 +429,28 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
                                 intensity=sink.intensity(la, lr))
             products["quicklook"] = str(config.quicklook)
         slc_hashed()
+    inten = None
+    if geotiffs:
+        inten = sink.intensity(config.looks_az, config.looks_rg)
+        if config.radiometry:
+            from sarcli.calibration.products import radiometric_intensity
+
+            inten, tags = radiometric_intensity(slc, inten, config.looks_az, config.looks_rg, config.radiometry,
+                                                terrain, config.noise_subtraction, tags)
     if config.geotiff_slant:
         from sarcli.focus.geocode import write_slant_geotiff
 
         write_slant_geotiff(config.geotiff_slant, slc, config.looks_az, config.looks_rg, tags, terrain,
-                            inputs=(config.output,), intensity=sink.intensity(config.looks_az, config.looks_rg),
-                            compression=config.geotiff_compression)
+                            inputs=(config.output,), intensity=inten,
+                            compression=config.geotiff_compression, radiometry=config.radiometry)
         products["geotiff_slant"] = str(config.geotiff_slant)
     if config.geotiff:
         from sarcli.focus.geocode import write_map_geotiff
 
         used = write_map_geotiff(config.geotiff, slc, config.looks_az, config.looks_rg, config.crs,
                                  config.pixel_spacing_m, tags, terrain, inputs=(config.output,),
-                                 intensity=sink.intensity(config.looks_az, config.looks_rg),
-                                 compression=config.geotiff_compression)
+                                 intensity=inten, compression=config.geotiff_compression,
+                                 radiometry=config.radiometry)
         products["geotiff"] = str(config.geotiff)
         products["crs"] = used
     return products

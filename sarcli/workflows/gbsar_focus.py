@@ -1,6 +1,6 @@
 """``gbsar_focus``: scan product -> focused image product (+ UTM / ENU GeoTIFFs and a quicklook).
 
-Range compression, then DF, RD, BP or ``auto`` (DF beyond the eq. 12 limit, BP or RD nearer); see
+Range compression, then DF, RD, BP, FFBP or ``auto`` (DF beyond the eq. 12 limit, BP or RD nearer); see
 :mod:`sarcli.gbsar.focus`. The image lies in the slant plane of the rail (range R0 from the rail line,
 azimuth x along it); its phase at a scatterer is ``-4 pi R0/lam`` for every algorithm. Everything
 that can be refused is refused before any focusing: an output that is the input, a missing output
@@ -42,7 +42,7 @@ class Config:
 
     scan: Path
     output: Path
-    algorithm: Literal["auto", "df", "rd", "bp"] = "auto"
+    algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
     pols: tuple[str, ...] = ()
     max_range_m: float | None = None
     min_range_m: float = 0.0
@@ -61,6 +61,8 @@ class Config:
     quicklook: Path | None = None
     grid_m: tuple[float, ...] | None = None
     permittivity: float = 1.0
+    bp_precision: Literal["single", "double"] = "single"
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
         self.options()  # every option checked when the configuration is made, before any file is opened
@@ -74,7 +76,8 @@ class Config:
                             azimuth_window=self.azimuth_window, max_range_m=self.max_range_m,
                             min_range_m=self.min_range_m, pixel_x_m=self.pixel_x_m, width_m=self.width_m,
                             criterion_rad=criterion_rad(self.criterion_deg), near=self.near, n_xfft=self.n_xfft,
-                            rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity)
+                            rd_reference=self.rd_reference, grid_m=self.grid_m or (), permittivity=self.permittivity,
+                            bp_precision=self.bp_precision, device=self.device)
 
 
 @dataclass
@@ -94,7 +97,8 @@ class GbsarFocusReport(Report):
     def lines(self) -> list[str]:
         g = self.focus.get("grid")
         if g is not None:
-            return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, bp on the grid x "
+            return [f"wrote {self.output}: {self.shape[0]} x {self.shape[1]} pixels, {next(iter(self.focus['used']))} "
+                    f"on the grid x "
                     f"{g['x_m'][0]:g}..{g['x_m'][1]:g} m, y {g['y_m'][0]:g}..{g['y_m'][1]:g} m at z {g['z_m']:g} m "
                     f"from {self.focus['n_sweeps']} sweeps ({self.focus['track']} track"
                     f"{', reference ranges' if self.focus['reference_range'] else ''}); "

@@ -16,7 +16,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 BASE = {"sarcli", "sarcli.errors", "sarcli.config", "sarcli.registry", "sarcli.threads", "sarcli.versions",
         "sarcli.memory"}
-PROCESSING = {"doppler", "focus", "ati", "gbsar", "sim", "optical", "design", "acquire", "monitor", "calibration"}
+PROCESSING = {"doppler", "focus", "ati", "gbsar", "sim", "optical", "design", "acquire", "monitor", "calibration",
+              "gpu"}
 #: sarcli.parallel sits beside the workflows (it runs them as Dask tasks, they call it for block-parallel focus)
 RANK = {"orbit": 0, "model": 1, "io": 2, "processing": 3, "workflows": 4, "parallel": 4, "cli": 5}
 

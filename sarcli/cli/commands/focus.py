@@ -31,7 +31,8 @@ def focus(
     accept_unresolved: bool = typer.Option(False, "--accept-unresolved-ambiguity",
                                            help="Use a Doppler model whose PRF ambiguity is unresolved."),
     algorithm: str = typer.Option("rd", "--algorithm", help="Focuser: rd (Range-Doppler), backprojection, "
-                                  "optical, a plug-in, or auto (the cheapest whose predicted error meets --quality)."),
+                                  "ffbp (fast factorized backprojection), optical, a plug-in, or auto (the cheapest "
+                                  "whose predicted error meets --quality)."),
     quality: str = typer.Option(None, "--quality", help="What --algorithm auto must meet, e.g. "
                                 "irw=0.02,pslr=1,phase=0.1 (the default: IRW within 2 %, PSLR within 1 dB, peak "
                                 "phase within 0.1 rad of the ideal; time=SECONDS: the longest predicted run)."),
@@ -73,10 +74,18 @@ def focus(
     looks_az: int = typer.Option(1, "--looks-az", help="Azimuth looks for the GeoTIFFs/quicklook."),
     looks_rg: int = typer.Option(1, "--looks-rg", help="Range looks for the GeoTIFFs/quicklook."),
     quicklook: Path = typer.Option(None, "--quicklook", help="Quicklook PNG of the amplitude (dB)."),
+    radiometry: str = typer.Option(None, "--radiometry", metavar="[beta0|sigma0|gamma0]",
+                                   help="GeoTIFFs in calibrated backscatter (dB band, units in the tags); gamma0 "
+                                   "terrain-flattened over --dem."),
+    noise_subtraction: bool = typer.Option(False, "--noise-subtraction", help="Subtract the noise floor (NESZ) "
+                                           "from the --radiometry GeoTIFFs."),
     workers: int = typer.Option(None, "--workers", help="Focus the blocks in parallel on a local Dask cluster of "
                                 "this many processes (the same image)."),
     scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
                                   "scheduler (tcp://host:8786; the raw file must be visible to its workers)."),
+    device: str = typer.Option(None, "--device", metavar="[cpu|cuda]", envvar="SARCLI_DEVICE",
+                               help="Where the focuser runs: cpu (default) or cuda (rd, csa and backprojection; needs "
+                               "a GPU and the gpu extra, docs/parallel.md)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON report on stdout."),
 ) -> None:
     """Focus a stripmap raw product into a single-look complex image.
@@ -101,7 +110,13 @@ def focus(
 
       sarcli focus raw.h5 -o bp.h5 --algorithm backprojection --set lines=[900,1000] --range-window rect
 
+      sarcli focus raw.h5 -o wk.h5 --algorithm omegak --set stolt_kernel=sinc8
+
       sarcli focus big_raw.h5 -o slc.h5 --fdc -6690 --fr -1990 --workers 2
+
+      sarcli focus raw.h5 -o slc.h5 --device cuda    # on the GPU (pip install 'sarcli[gpu]')
+
+      sarcli focus raw.h5 -o slc.h5 --geotiff sigma0.tif --radiometry sigma0 --looks-az 4
 
       sarcli focus raw.h5 -o slc.h5 --algorithm auto --quality irw=0.02,pslr=1,phase=0.1 --json
     """
@@ -124,6 +139,7 @@ def focus(
                     crs=crs, pixel_spacing_m=spacing,
                     looks_az=looks_az, looks_rg=looks_rg, channel=channel,
                     accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler,
+                    radiometry=radiometry, noise_subtraction=noise_subtraction, device=_device(device),
                     quality=quality)
     with progress_bar(1, label="focusing") as bar:
         def progress(label: str, done: int, total: int) -> None:
@@ -138,6 +154,16 @@ def focus(
     else:
         for line in rep.lines():
             info(line)
+
+
+def _device(name: str | None) -> str | None:
+    """``--device`` (or ``SARCLI_DEVICE``) checked: cpu | cuda, or None when neither is given."""
+    if name is None or not name.strip():
+        return None
+    d = name.strip().lower()
+    if d not in ("cpu", "cuda"):
+        raise ConfigError(f"--device must be cpu or cuda, got {name!r}")
+    return d
 
 
 def _geoid(name: str | None):

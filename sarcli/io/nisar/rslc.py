@@ -18,6 +18,9 @@ Layout (``/science/{LSAR|SSAR}/``; ISCE3 ``nisar.products.writers.SLC`` and read
         frequency order; attributes window_name/window_shape), referenceTerrainHeight,
         runConfigurationContents (sarcli: the processing parameters as JSON)
     RSLC/metadata/processingInformation/{algorithms, inputs}   strings (software version, inputs)
+    RSLC/metadata/calibrationInformation/geometry/{beta0, sigma0, gamma0, zeroDopplerTime, slantRange}
+        the SLC's radiometric LUTs (X = |DN|^2 * X), frequencyA/{pol}/nes0, absoluteCalibrationConstant
+        (when the SLC carries a calibration: :mod:`sarcli.calibration.radiometry`)
     RSLC/metadata/geolocationGrid/  cubes (height, zeroDopplerTime, slantRange): coordinateX/Y (lon/lat,
         epsg 4326), incidenceAngle, elevationAngle, losUnitVectorX/Y, alongTrackUnitVectorX/Y,
         groundTrackVelocity; axes heightAboveEllipsoid (-500..9000 m, 20 levels), zeroDopplerTime,
@@ -38,6 +41,7 @@ a space or a ``T`` and fractional seconds, missing optional items (attitude, Dop
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from collections.abc import Mapping
@@ -350,6 +354,8 @@ def write_rslc(path: str | os.PathLike, images: Mapping[str, SLC], meta: RslcMet
             _write_attitude(md, slc, sv, sv_file, frac, units, h)
         _write_processing(md, slc, meta, frac, units, [*meta.input_names])
         _write_geolocation_grid(md, sv_file, t, r, lam, slc.look_side, units)
+        if slc.calibration is not None:
+            _write_calibration(md, slc.calibration, frac, units, meta.frequency, list(images))
         _write_identification(sci, slc, sv_file, t, r, meta, band_letter, epoch, h)
 
 
@@ -439,6 +445,29 @@ def _write_processing(md: h5py.Group, slc: SLC, meta: RslcMeta, frac: float, uni
     for k in ("orbitFiles", "attitudeFiles", "auxcalFiles", "configFiles"):
         _put(inp, k, [""], f"List of input {k[:-5]} files used")
     _put(inp, "demSource", "", "Description of the input digital elevation model (DEM)")
+
+
+def _write_calibration(md: h5py.Group, cal, frac: float, units: str, frequency: str, pols: list[str]) -> None:
+    """metadata/calibrationInformation: the SLC's radiometric LUTs (:class:`sarcli.model.slc.Calibration`) in
+    the RSLC layout: geometry/{beta0, sigma0, gamma0} on (zeroDopplerTime, slantRange), multiplicative
+    (X = |DN|^2 * X), NaN where not calibrated; frequencyX/{pol}/nes0 the noise-equivalent sigma0 (linear)."""
+    ci = group(md, "calibrationInformation")
+    geo = group(ci, "geometry")
+    _put(geo, "zeroDopplerTime", cal.azimuth_time + frac, "Zero doppler time dimension of the calibration LUTs",
+         units)
+    _put(geo, "slantRange", cal.slant_range, "Slant range dimension of the calibration LUTs", "meters")
+    for name, what in (("beta0", "beta0"), ("sigma0", "sigma0 (ellipsoid incidence)"),
+                       ("gamma0", "gamma0 (ellipsoid incidence)")):
+        _put(geo, name, np.asarray(getattr(cal, name), np.float32), f"2D LUT to convert |DN|^2 to {what}: "
+             f"{name} = |DN|^2 * LUT (sarcli radiometric model; not applied: "
+             f"{'; '.join(cal.not_applied) or 'none'})", "1")
+    fq = group(ci, f"frequency{frequency}")
+    for pol in pols:
+        pg = group(fq, pol)
+        _put(pg, "nes0", np.asarray(cal.nes0, np.float32), "Noise equivalent sigma0 (linear) on the calibration "
+             "LUT grid", "1")
+    _put(ci, "absoluteCalibrationConstant", float(cal.constant), "sarcli's absolute calibration constant K "
+         "(|DN|^2 = K F beta0)", "1")
 
 
 def _write_geolocation_grid(md: h5py.Group, sv: StateVectors, t: np.ndarray, r: np.ndarray, lam: float, side: str,
@@ -582,7 +611,8 @@ def _radar(f: h5py.File, fg: h5py.Group, r: np.ndarray, path: Path) -> Radar:
     if text(f.attrs.get("product_type", b"")) == PRODUCT_TYPE and "sarcli_radar" in f.attrs:
         kw = json.loads(text(f.attrs["sarcli_radar"]))
         kw["receiver_offsets_m"] = tuple(kw.get("receiver_offsets_m", (0.0,)))
-        kw = {k: (np.nan if v is None and k != "platform_velocity_mps" else v) for k, v in kw.items()}
+        optional = {fl.name for fl in dataclasses.fields(Radar) if fl.default is None}
+        kw = {k: (np.nan if v is None and k not in optional else v) for k, v in kw.items()}
         return Radar(**kw)
     fc_name = "processedCenterFrequency" if "processedCenterFrequency" in fg else "acquiredCenterFrequency"
     fc = number(fg, fc_name, path, positive=True)

@@ -54,3 +54,4 @@ def apply(ctx, params, product):
         arr.real += rng.standard_normal(arr.shape, dtype=np.float32) * sd
         arr.imag += rng.standard_normal(arr.shape, dtype=np.float32) * sd
     product.truth["noise_power"] = np.float64(pn)
+    product.radar.noise_power = float(pn)  # the receiver noise level the product states (radiometry)

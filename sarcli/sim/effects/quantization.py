@@ -78,4 +78,8 @@ def apply(ctx, params, product):
         product.replica = quantize(product.replica * (rms * np.sqrt(2.0)), bits)
     product.agc_db = a.astype(np.float32)
     product.radar.quantization_bits = bits
+    # the stated thermal noise, through the receiver gain G (the focuser undoes the AGC, not G); the
+    # quantization noise is not in it
+    if getattr(product.radar, "noise_power", None) is not None:
+        product.radar.noise_power *= gain**2
     product.truth["receiver_gain_db"] = np.float64(g_db)
