@@ -97,7 +97,7 @@ KNOB_SETTINGS: dict[str, list[dict[str, Any]]] = {
 #: per algorithm. ``rd`` and ``backprojection``: measured by bench/bench_focus_family.py (see
 #: docs/focusing.md); the others are operation counts relative to the RDA [CumWong2005, sec. 7.7,
 #: 8.5; UlaHelSte2003, sec. IV] until the map measures them after they are registered.
-COST_RD = 3.2  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.2-7.7 on a loaded machine)
+COST_RD = 3.1  # whole RD focus / two fft2 (bench_focus_family, median over its 16 scenes; 1.5-6.2 on a loaded machine)
 # csa and omegak: their own benchmarks' ratio to rd on the same 1536 x 2048 block in the same run
 # (bench_csa: 1.28; bench_omegak: monochromatic 1.58, full Stolt 5.4 with sinc8 or sinc16: its longer
 # range FFT, not the kernel, dominates), until the map measures them on its scenes
@@ -105,13 +105,13 @@ COST_CSA = 1.28 * COST_RD
 COST_OMEGAK_MONO = 1.58 * COST_RD
 COST_OMEGAK_FULL = 5.4 * COST_RD
 #: backprojection: seconds per (pixel x aperture line) over seconds per (sample x log2 samples) of two fft2
-COST_BP = 57.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block (50 the run before)
+COST_BP = 35.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block (35-57 in 3 runs)
 #: ffbp: one interpolation tap of a merge against one exact backprojection term, from the ffbp focuser
 #: on the map's airborne X band scene (1440 x 244, 1140 aperture lines, default knobs: 19.9 s, against
 #: the exact kernel's 180 s extrapolated with COST_BP = 50; same machine, same load), to be re-measured
 COST_FFBP_TAP = 0.036 * 50.0 / COST_BP
 #: the 2 fft2 time per (sample x log2 samples) on the bench machine (s): predicted seconds for the report
-SECONDS_2FFT2 = 8.9e-9  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
+SECONDS_2FFT2 = 4.0e-9  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
 #: on an ORBIT, the largest |squint| (deg) at which the map validated the hyperbolic-model focusers: beyond
 #: it the orbit's range history departs from the hyperbola over the beam offset R0 tan(theta) / V (21 s at
 #: 10 deg from 850 km) and the RDA showed a range offset of 0.38 pixel and 1.8 rad of peak phase at 10 deg
