@@ -298,36 +298,42 @@ def _window_mean(mode, s0, s1, x, y, z, bpar, pos, vel, par, wtab, ctab, span_ma
     return (_cum(ctab, hi) - _cum(ctab, lo)) / (hi - lo), False
 
 
+@njit(cache=True, inline="always")
+def _stage0_sample(lines, r_first, dr_in, k, pos, ref, w, n0, n1, fr, p0, nrm, r, u):
+    """One stage-0 polar sample (r, u) of the subaperture of pulses n0..n1-1 with frame ``fr``: its pulses
+    backprojected there (the CPU and the CUDA kernels share this code)."""
+    n_in = lines.shape[1]
+    x, y, z = _polar_point(fr, p0, nrm, r, u)
+    acc = 0j
+    for n in range(n0, n1):
+        if w[n] == 0.0:
+            continue
+        dx = x - pos[n, 0]
+        dy = y - pos[n, 1]
+        dz = z - pos[n, 2]
+        rho = math.sqrt(dx * dx + dy * dy + dz * dz) - ref[n]
+        p = (rho - r_first) / dr_in
+        i = int(math.floor(p))
+        if i < 0 or i + 1 >= n_in:
+            continue
+        mu = p - i
+        v = lines[n, i] * (1.0 - mu) + lines[n, i + 1] * mu
+        acc += w[n] * v * _cis(k * (rho - r))
+    return acc
+
+
 @njit(cache=True, parallel=True)
 def stage0_kernel(lines, r_first, dr_in, k, pos, ref, w, sub_start, sub_stop, frames, p0, nrm,
                   g_r0, g_u0, g_du, g_nr, g_nu, g_off, dr, row_sub, row_iu, out):
     """Stage 0: the pulses of each subaperture backprojected onto its polar grid (rows (s, iu) in parallel)."""
-    n_in = lines.shape[1]
     for q in prange(row_sub.size):
         s = row_sub[q]
         iu = row_iu[q]
         u = g_u0[s] + iu * g_du[s]
         base = g_off[s] + iu * g_nr[s]
-        fr = frames[s]
         for ir in range(g_nr[s]):
-            r = g_r0[s] + ir * dr
-            x, y, z = _polar_point(fr, p0, nrm, r, u)
-            acc = 0j
-            for n in range(sub_start[s], sub_stop[s]):
-                if w[n] == 0.0:
-                    continue
-                dx = x - pos[n, 0]
-                dy = y - pos[n, 1]
-                dz = z - pos[n, 2]
-                rho = math.sqrt(dx * dx + dy * dy + dz * dz) - ref[n]
-                p = (rho - r_first) / dr_in
-                i = int(math.floor(p))
-                if i < 0 or i + 1 >= n_in:
-                    continue
-                mu = p - i
-                v = lines[n, i] * (1.0 - mu) + lines[n, i + 1] * mu
-                acc += w[n] * v * _cis(k * (rho - r))
-            out[base + ir] = acc
+            out[base + ir] = _stage0_sample(lines, r_first, dr_in, k, pos, ref, w, sub_start[s], sub_stop[s],
+                                            frames[s], p0, nrm, g_r0[s] + ir * dr, u)
 
 
 @njit(cache=True, inline="always")
@@ -364,6 +370,29 @@ def _interp(img, off, nr, nu, fr_, fu, order, range_order, tab_u, tab_r, wr, wu)
     return acc
 
 
+@njit(cache=True, inline="always")
+def _merge_sample(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, c0, c1, fr, p0, nrm, r, u, dr, k, order,
+                  range_order, tab_u, tab_r, wr, wu):
+    """One parent polar sample (r, u) of frame ``fr``: its children c0..c1-1 interpolated there and
+    re-referenced (``wr``, ``wu``: scratch of MAX_ORDER; the CPU and the CUDA kernels share this code)."""
+    x, y, z = _polar_point(fr, p0, nrm, r, u)
+    acc = 0j
+    for c in range(c0, c1):
+        if c_nr[c] == 0:
+            continue
+        cf = c_frames[c]
+        dx = x - cf[0, 0]
+        dy = y - cf[0, 1]
+        dz = z - cf[0, 2]
+        rc = math.sqrt(dx * dx + dy * dy + dz * dz)
+        uc = (dx * cf[1, 0] + dy * cf[1, 1] + dz * cf[1, 2]) / rc
+        v = _interp(child, c_off[c], c_nr[c], c_nu[c], (rc - c_r0[c]) / dr, (uc - c_u0[c]) / c_du[c],
+                    order, range_order, tab_u, tab_r, wr, wu)
+        if v != 0j:
+            acc += v * _cis(k * (rc - r))
+    return acc
+
+
 @njit(cache=True, parallel=True)
 def merge_kernel(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start, kid_stop, frames, p0, nrm,
                  g_r0, g_u0, g_du, g_nr, g_off, dr, k, order, range_order, tab_u, tab_r, row_sub, row_iu, out):
@@ -375,25 +404,55 @@ def merge_kernel(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start
         wu = np.empty(MAX_ORDER)
         u = g_u0[s] + iu * g_du[s]
         base = g_off[s] + iu * g_nr[s]
-        fr = frames[s]
         for ir in range(g_nr[s]):
-            r = g_r0[s] + ir * dr
-            x, y, z = _polar_point(fr, p0, nrm, r, u)
-            acc = 0j
-            for c in range(kid_start[s], kid_stop[s]):
-                if c_nr[c] == 0:
-                    continue
-                cf = c_frames[c]
-                dx = x - cf[0, 0]
-                dy = y - cf[0, 1]
-                dz = z - cf[0, 2]
-                rc = math.sqrt(dx * dx + dy * dy + dz * dz)
-                uc = (dx * cf[1, 0] + dy * cf[1, 1] + dz * cf[1, 2]) / rc
-                v = _interp(child, c_off[c], c_nr[c], c_nu[c], (rc - c_r0[c]) / dr, (uc - c_u0[c]) / c_du[c],
-                            order, range_order, tab_u, tab_r, wr, wu)
-                if v != 0j:
-                    acc += v * _cis(k * (rc - r))
-            out[base + ir] = acc
+            out[base + ir] = _merge_sample(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start[s],
+                                           kid_stop[s], frames[s], p0, nrm, g_r0[s] + ir * dr, u, dr, k, order,
+                                           range_order, tab_u, tab_r, wr, wu)
+
+
+@njit(cache=True)
+def _final_pixel(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, sub_stop, sub_w, x, y, z, r_out, dr, k,
+                 order, range_order, tab_u, tab_r, mode, bpar, pos, vel, par, wtab, ctab, span_max, lines, r_first,
+                 dr_in, ref, w, wr, wu):
+    """(image, sum of the window x pulse weights used) of the pixel (x, y, z) with output reference
+    ``r_out`` and window parameter ``bpar`` (:func:`final_kernel`; the CPU and the CUDA kernels share this code)."""
+    n_in = lines.shape[1]
+    acc = 0j
+    ws = 0.0
+    for s in range(g_r0.size):
+        wm, exact = _window_mean(mode, sub_start[s], sub_stop[s], x, y, z, bpar, pos, vel, par, wtab, ctab,
+                                 span_max)
+        if wm == 0.0 and not exact:
+            continue
+        if not exact:  # interpolate its polar image, or backproject it where that does not hold the pixel
+            fr = frames[s]
+            dx = x - fr[0, 0]
+            dy = y - fr[0, 1]
+            dz = z - fr[0, 2]
+            rc = math.sqrt(dx * dx + dy * dy + dz * dz)
+            f_r = (rc - g_r0[s]) / dr
+            f_u = ((dx * fr[1, 0] + dy * fr[1, 1] + dz * fr[1, 2]) / rc - g_u0[s]) / g_du[s]
+            if _inside(g_nr[s], g_nu[s], f_r, f_u, order, range_order):
+                v = _interp(img, g_off[s], g_nr[s], g_nu[s], f_r, f_u, order, range_order, tab_u, tab_r, wr, wu)
+                acc += wm * v * _cis(k * (rc - r_out))
+                ws += wm * sub_w[s]
+                continue
+        for n in range(sub_start[s], sub_stop[s]):
+            wn = w[n] if mode == 0 else w[n] * _table(wtab, _band_u(mode, n, x, y, z, bpar, pos, vel, par))
+            if wn == 0.0:
+                continue
+            ex = x - pos[n, 0]
+            ey = y - pos[n, 1]
+            ez = z - pos[n, 2]
+            rho = math.sqrt(ex * ex + ey * ey + ez * ez) - ref[n]
+            p = (rho - r_first) / dr_in
+            if not (p >= 0.0 and p < n_in - 1):
+                continue
+            i = int(p)
+            mu = p - i
+            acc += wn * (lines[n, i] * (1.0 - mu) + lines[n, i + 1] * mu) * _cis(k * (rho - r_out))
+            ws += wn
+    return acc, ws
 
 
 @njit(cache=True, parallel=True)
@@ -404,50 +463,13 @@ def final_kernel(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, su
     across a band edge (or spanning much of a short window, :func:`_window_mean`), or whose polar grid
     does not hold the pixel, is backprojected pulse by pulse with the exact window instead, as the exact
     kernels do. ``wsum``: the sum of the window x pulse weights used."""
-    n_in = lines.shape[1]
     for m in prange(pix.shape[0]):
         wr = np.empty(MAX_ORDER)
         wu = np.empty(MAX_ORDER)
-        x = pix[m, 0]
-        y = pix[m, 1]
-        z = pix[m, 2]
-        acc = 0j
-        ws = 0.0
-        for s in range(g_r0.size):
-            wm, exact = _window_mean(mode, sub_start[s], sub_stop[s], x, y, z, bpar[m], pos, vel, par, wtab, ctab,
-                                     span_max)
-            if wm == 0.0 and not exact:
-                continue
-            if not exact:  # interpolate its polar image, or backproject it where that does not hold the pixel
-                fr = frames[s]
-                dx = x - fr[0, 0]
-                dy = y - fr[0, 1]
-                dz = z - fr[0, 2]
-                rc = math.sqrt(dx * dx + dy * dy + dz * dz)
-                f_r = (rc - g_r0[s]) / dr
-                f_u = ((dx * fr[1, 0] + dy * fr[1, 1] + dz * fr[1, 2]) / rc - g_u0[s]) / g_du[s]
-                if _inside(g_nr[s], g_nu[s], f_r, f_u, order, range_order):
-                    v = _interp(img, g_off[s], g_nr[s], g_nu[s], f_r, f_u, order, range_order, tab_u, tab_r, wr, wu)
-                    acc += wm * v * _cis(k * (rc - r_out[m]))
-                    ws += wm * sub_w[s]
-                    continue
-            for n in range(sub_start[s], sub_stop[s]):
-                wn = w[n] if mode == 0 else w[n] * _table(wtab, _band_u(mode, n, x, y, z, bpar[m], pos, vel, par))
-                if wn == 0.0:
-                    continue
-                ex = x - pos[n, 0]
-                ey = y - pos[n, 1]
-                ez = z - pos[n, 2]
-                rho = math.sqrt(ex * ex + ey * ey + ez * ez) - ref[n]
-                p = (rho - r_first) / dr_in
-                if not (p >= 0.0 and p < n_in - 1):
-                    continue
-                i = int(p)
-                mu = p - i
-                acc += wn * (lines[n, i] * (1.0 - mu) + lines[n, i + 1] * mu) * _cis(k * (rho - r_out[m]))
-                ws += wn
-        out[m] = acc
-        wsum[m] = ws
+        out[m], wsum[m] = _final_pixel(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, sub_stop, sub_w,
+                                       pix[m, 0], pix[m, 1], pix[m, 2], r_out[m], dr, k, order, range_order, tab_u,
+                                       tab_r, mode, bpar[m], pos, vel, par, wtab, ctab, span_max, lines, r_first,
+                                       dr_in, ref, w, wr, wu)
 
 
 @njit(cache=True, parallel=True)
@@ -597,7 +619,7 @@ def top_length(knobs: FfbpKnobs, n_pulses: int, window: ApertureWindow | None) -
 def ffbp(lines: np.ndarray, r_first: float, dr: float, range_cell: float, wavelength: float, wavelength_min: float,
          pos: np.ndarray, ref: np.ndarray, weights: np.ndarray, pixels: np.ndarray, r_out: np.ndarray, knobs: FfbpKnobs,
          window: ApertureWindow | None = None, first_index: int = 0, plane: tuple[np.ndarray, np.ndarray] | None = None,
-         stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+         stats: dict | None = None, device: str = "cpu") -> tuple[np.ndarray, np.ndarray]:
     """FFBP of ``lines`` (n_pulses, n_r) from ``pos`` (n_pulses, 3) onto ``pixels`` (n1, n2, 3) -> (image
     complex128 (n1, n2), weight sum (n1, n2)) (module docstring: notation, conventions, errors).
     ``range_cell`` = c/(2 B) the lines' resolution (m), ``ref`` (n_pulses,) the lines' reference ranges,
@@ -605,7 +627,9 @@ def ffbp(lines: np.ndarray, r_first: float, dr: float, range_cell: float, wavele
     pulse 0 (subapertures align to it), ``plane`` (a point towards the scene centre, its normal) where the
     polar samples lie (default: fitted to the pixels; a block-independent one keeps blocks identical),
     ``stats`` gets the stage count, the polar sample counts (total, per level, largest grid per level) and
-    the stage times."""
+    the stage times. ``device="cuda"``: the stages run as the CUDA kernels of :mod:`sarcli.gpu.ffbp_cuda`
+    (the same helpers compiled for the card; the polar images stay on the device between stages), the plan
+    (grids, extents) on the CPU."""
     pix = np.ascontiguousarray(pixels, np.float64)
     n1, n2 = pix.shape[:2]
     pos = np.ascontiguousarray(pos, np.float64)
@@ -678,34 +702,53 @@ def ffbp(lines: np.ndarray, r_first: float, dr: float, range_cell: float, wavele
     lines_c = np.ascontiguousarray(lines)
     tab_u = kernel_table(knobs.order, knobs.oversample)
     tab_r = kernel_table(knobs.range_order, range_cell / dr_p)
+    dev = None
+    if device == "cuda":
+        from sarcli.gpu import ffbp_cuda
+        from sarcli.gpu.device import require_cuda
+        dev = require_cuda()
+        lines_c = dev.asarray(lines_c)
     img = None
     seconds = []
     for li, lv in enumerate(levels):
         t0 = time.perf_counter()
         row_sub = np.repeat(np.arange(lv.nu.size), lv.nu).astype(np.int64)
         row_iu = (np.arange(row_sub.size) - np.repeat(np.cumsum(lv.nu) - lv.nu, lv.nu)).astype(np.int64)
-        out = np.zeros(lv.size, np.complex64)
         if li == 0:
-            stage0_kernel(lines_c, float(r_first), float(dr), k, pos, ref, w, lv.start, lv.stop, lv.frames, p0, nrm,
-                          lv.r0, lv.u0, lv.du, lv.nr, lv.nu, lv.off, dr_p, row_sub, row_iu, out)
+            args = (lines_c, float(r_first), float(dr), k, pos, ref, w, lv.start, lv.stop, lv.frames, p0, nrm,
+                    lv.r0, lv.u0, lv.du, lv.nr)
+            if dev is not None:
+                out = ffbp_cuda.stage0(dev, *args, lv.off, dr_p, row_sub, row_iu, lv.size)
+            else:
+                out = np.zeros(lv.size, np.complex64)
+                stage0_kernel(*args, lv.nu, lv.off, dr_p, row_sub, row_iu, out)
         else:
             ch = levels[li - 1]
             kid = np.searchsorted(ch.start, lv.start).astype(np.int64)
             kid_stop = np.searchsorted(ch.start, lv.stop).astype(np.int64)
-            merge_kernel(img, ch.frames, ch.r0, ch.u0, ch.du, ch.nr, ch.nu, ch.off, kid, kid_stop, lv.frames, p0,
-                         nrm, lv.r0, lv.u0, lv.du, lv.nr, lv.off, dr_p, k, knobs.order, knobs.range_order, tab_u,
-                         tab_r, row_sub, row_iu, out)
+            args = (img, ch.frames, ch.r0, ch.u0, ch.du, ch.nr, ch.nu, ch.off, kid, kid_stop, lv.frames, p0, nrm,
+                    lv.r0, lv.u0, lv.du, lv.nr, lv.off, dr_p, k, knobs.order, knobs.range_order, tab_u, tab_r,
+                    row_sub, row_iu)
+            if dev is not None:
+                out = ffbp_cuda.merge(dev, *args, lv.size)
+            else:
+                out = np.zeros(lv.size, np.complex64)
+                merge_kernel(*args, out)
         img = out
         seconds.append(time.perf_counter() - t0)
     t0 = time.perf_counter()
     lv = levels[-1]
     sub_w = np.add.reduceat(w, lv.start) if lv.start.size else np.zeros(0)
-    res = np.zeros(n1 * n2, np.complex128)
-    wsum = np.zeros(n1 * n2)
-    final_kernel(img, lv.frames, lv.r0, lv.u0, lv.du, lv.nr, lv.nu, lv.off, lv.start, lv.stop, sub_w,
-                 np.ascontiguousarray(flat), np.ascontiguousarray(np.broadcast_to(r_out, (n1, n2)).ravel(), np.float64),
-                 dr_p, k, knobs.order, knobs.range_order, tab_u, tab_r, mode, bpar.ravel(), pos, vel, par, wtab, ctab,
-                 1.0 / knobs.aperture_split, lines_c, float(r_first), float(dr), ref, w, res, wsum)
+    args = (img, lv.frames, lv.r0, lv.u0, lv.du, lv.nr, lv.nu, lv.off, lv.start, lv.stop, sub_w,
+            np.ascontiguousarray(flat), np.ascontiguousarray(np.broadcast_to(r_out, (n1, n2)).ravel(), np.float64),
+            dr_p, k, knobs.order, knobs.range_order, tab_u, tab_r, mode, bpar.ravel(), pos, vel, par, wtab, ctab,
+            1.0 / knobs.aperture_split, lines_c, float(r_first), float(dr), ref, w)
+    if dev is not None:
+        res, wsum = ffbp_cuda.final(dev, *args)
+    else:
+        res = np.zeros(n1 * n2, np.complex128)
+        wsum = np.zeros(n1 * n2)
+        final_kernel(*args, res, wsum)
     if stats is not None:
         stats.update({"merge_stages": n_levels - 1, "top_subapertures": int(lv.start.size),
                       "top_pulses": int(lengths[-1]), "polar_samples": total,

@@ -37,8 +37,9 @@ class FfbpOptions(BpOptions):
     (:class:`sarcli.focus.ffbp.FfbpKnobs`): ``base`` subapertures merged per stage, ``oversample`` the
     angular oversampling, ``order`` / ``range_order`` interpolation taps (2 linear, 4-8 Knab sinc),
     ``range_oversample`` of the polar grids' range spacing, ``aperture_split`` top subapertures per
-    synthetic aperture. BP's ``precision`` and ``device`` keep their defaults (single, cpu): FFBP has its own
-    arithmetic and no GPU path. Defaults: GOTCHA's accuracy bar (peaks within 0.1 pixel, PSLR within 0.5 dB of
+    synthetic aperture. BP's ``precision`` keeps its default (single): FFBP has its own arithmetic; ``device``
+    cuda runs its stages on the GPU (:mod:`sarcli.gpu.ffbp_cuda`, the same arithmetic). Defaults: GOTCHA's
+    accuracy bar (peaks within 0.1 pixel, PSLR within 0.5 dB of
     BP; docs/focusing.md)."""
 
     base: int = 4
@@ -51,9 +52,6 @@ class FfbpOptions(BpOptions):
     def __post_init__(self) -> None:
         super().__post_init__()
         self.knobs()
-        if self.device == "cuda":
-            raise ConfigError("ffbp runs on the CPU only (its merge stages have no CUDA kernels yet): use "
-                              "--device cpu, or --algorithm backprojection --device cuda")
         if self.precision != "single":
             raise ConfigError("ffbp has one precision (float64 geometry and phase, complex128 sums): drop "
                               "--double / precision")
@@ -107,7 +105,8 @@ class Ffbp(Backprojection):
         stats: dict = {}
         img, _ = ffbp(up, radar.first_range_m, C / (2 * radar.range_sampling_rate_hz * k.upsample), C / (2 * band),
                       g.wavelength, C / (radar.carrier_frequency_hz + band / 2), pos, np.zeros(pos.shape[0]),
-                      np.ones(pos.shape[0]), pix, rr, k.knobs(), win, first_index=a, plane=plan.plane, stats=stats)
+                      np.ones(pos.shape[0]), pix, rr, k.knobs(), win, first_index=a, plane=plan.plane, stats=stats,
+                      device=k.device)
         plan.stages = {"merge_stages": stats["merge_stages"], "top_lines": stats["top_pulses"]}
         return img
 

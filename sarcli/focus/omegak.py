@@ -87,7 +87,7 @@ import math
 import queue
 import time
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.fft as sfft
@@ -100,7 +100,6 @@ from sarcli.focus.rangecomp import C, chirp_band, range_filter, reference_pulse
 from sarcli.focus.rda import (
     CHUNK,
     RANGE_GUARD,
-    SHIFT_TOL_LINES,
     RangeDoppler,
     RdOptions,
     RdPlan,
@@ -110,11 +109,11 @@ from sarcli.focus.rda import (
     _n_threads,
     _pooled,
     _range_rows,
-    apply_line_phase,
-    correct_lines,
+    active_rows,
     smooth_len,
 )
 from sarcli.focus.windows import parse_window, table_lookup
+from sarcli.gpu.device import check_device
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC
 from sarcli.model.terrain import Terrain
@@ -133,6 +132,7 @@ class OmegakOptions:
     stolt_kernel: interpolator of the full mapping (linear, sinc4, sinc8, sinc16); stolt_oversample:
     range FFT length over the recorded extent (>= 1; 2 keeps the rows' content within half the span);
     rcmc, rcmc_oversample: the monochromatic mode's RCMC interpolator and range upsampling (as RD's).
+    device: cpu, or cuda (steps 1-4 on the GPU, :mod:`sarcli.gpu.omegak_xp`).
     The rest mean what they mean in :class:`sarcli.focus.rda.RdOptions`.
     """
 
@@ -150,8 +150,10 @@ class OmegakOptions:
     use_replica: bool = True
     orbit_timing: bool = True
     workers: int = -1
+    device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "device", check_device(self.device))
         if self.stolt not in STOLT_MODES:
             raise ConfigError(f"stolt must be one of {', '.join(STOLT_MODES)}, got {self.stolt!r}")
         kind, _ = parse_interpolator(self.stolt_kernel)
@@ -197,6 +199,18 @@ def stolt_input_frequency(f_out: np.ndarray, f_eta: np.ndarray, v: float, f0: fl
     a2 = (C * np.asarray(f_eta, np.float64) / (2.0 * v)) ** 2
     f = f0 + np.asarray(f_out, np.float64)
     return (f * f + a2 - f0 * f0) / (np.sqrt(f * f + a2) + f0)
+
+
+def block_parameters(plan: OmegakPlan, b: int) -> dict[str, Any]:
+    """Block ``b``'s parameters that the CPU and the CUDA paths share: ``f_eta`` the absolute azimuth frequency
+    of each row (unwrapped on the block's ``fdc_ref``), ``f_tau`` the range FFT frequencies (Hz), ``tau0`` the
+    two-way time of the first range sample (s) and ``active`` the rows inside the processed band at some range
+    (:func:`sarcli.focus.rda.active_rows`)."""
+    g, radar = plan.grid, plan.raw.radar
+    return {"f_eta": absolute_doppler(plan.f_bin, float(plan.fdc_ref[b]), g.prf),
+            "f_tau": sfft.fftfreq(plan.n_fft_r, 1.0 / radar.range_sampling_rate_hz),
+            "tau0": 2.0 * float(g.ranges[0]) / C,
+            "active": active_rows(plan.f_bin, plan.block[b]["fdc"], g.prf, g.ba)}
 
 
 def monochromatic_phase_error(r0: float, r_ref: float, f_eta, f_tau, v: float, f0: float) -> np.ndarray:
@@ -479,7 +493,7 @@ class Omegak(RangeDoppler):
                               " use a narrower azimuth band or --algorithm rd")
 
     def focus_block(self, plan: OmegakPlan, b: int, read_lines) -> np.ndarray:
-        k, g, raw = plan.options, plan.grid, plan.raw
+        k, g = plan.options, plan.grid
         n_lines, nr = plan.output_shape
         s, e = plan.block_rows(b)
         a, z = max(0, s - g.pad), min(n_lines, e + g.pad)
@@ -489,21 +503,40 @@ class Omegak(RangeDoppler):
         _add(tm, "io_s", t0)
         if data.shape != (z - a, nr):
             raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
+        gain = None if plan.gain is None else plan.gain[a:z]
+        prm = block_parameters(plan, b)
+        if k.device == "cuda":
+            from sarcli.gpu.device import require_cuda
+            from sarcli.gpu.omegak_xp import focus_rows
+
+            t0 = time.perf_counter()
+            img = focus_rows(plan, b, data, a - (s - g.pad), gain, prm, require_cuda())
+            _add(tm, "cuda_block_s", t0)
+        else:
+            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain, prm)
+        del data
+        return self._correct_block(plan, b, img)
+
+    def _focus_rows(self, plan: OmegakPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
+                    gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
+        """Steps 1-4 of the module docstring on the CPU: the block's (N x n_samples) azimuth-compressed lines,
+        raw lines ``data`` (times ``gain`` per line) at row ``off``; ``prm`` from :func:`block_parameters`."""
+        k, g, raw = plan.options, plan.grid, plan.raw
+        nr = plan.output_shape[1]
+        tm = plan.timings
         t0 = time.perf_counter()
         y = np.empty((plan.n_fft_az, plan.n_fft_r), plan.h.dtype)
-        _range_rows(y, a - (s - g.pad), data, None if plan.gain is None else plan.gain[a:z], k.workers)
-        del data
+        _range_rows(y, off, data, gain, k.workers)
         _add(tm, "range_fft_s", t0)
         t0 = time.perf_counter()
         _fft_inplace(y, 0, False, k.workers)
         _add(tm, "azimuth_fft_s", t0)
         q = plan.block[b]
-        f_eta = absolute_doppler(plan.f_bin, float(plan.fdc_ref[b]), g.prf)
+        f_eta, f_tau = prm["f_eta"], prm["f_tau"]
         t0 = time.perf_counter()
         if k.stolt == "full":
-            self._stolt_block(plan, b, y, f_eta, q)
+            self._stolt_block(plan, b, y, prm, q)
         else:
-            f_tau = sfft.fftfreq(plan.n_fft_r, 1.0 / raw.radar.range_sampling_rate_hz)
             _pooled([(c, min(c + CHUNK, y.shape[0])) for c in range(0, y.shape[0], CHUNK)],
                     lambda c, d: bulk_phase_rows(y[c:d], f_tau, f_eta[c:d], float(plan.v_ref[b]),
                                                  float(plan.r_ref[b]), raw.radar.carrier_frequency_hz), k.workers)
@@ -515,33 +548,19 @@ class Omegak(RangeDoppler):
         t0 = time.perf_counter()
         _fft_inplace(img, 0, True, k.workers)
         _add(tm, "azimuth_ifft_s", t0)
-        out = img[g.pad:g.pad + (e - s)]
-        t0 = time.perf_counter()
-        lines_c, phi, mu = self.line_corrections(plan, b)
-        if np.max(np.abs(mu)) >= SHIFT_TOL_LINES:
-            shifted = np.empty((e - s, nr), img.dtype)
-            correct_lines(img, g.pad, s, shifted, lines_c, plan.model.columns, phi, mu, q["fdc"] / g.prf,
-                          plan.shift_table)
-            out = shifted
-        elif np.any(phi != 0.0):
-            apply_line_phase(out, s, lines_c, plan.model.columns, phi)
-        _add(tm, "line_correction_s", t0)
-        return np.ascontiguousarray(out, np.complex64)
+        return img
 
     @staticmethod
-    def _stolt_block(plan: OmegakPlan, b: int, y: np.ndarray, f_eta: np.ndarray, q: dict) -> None:
+    def _stolt_block(plan: OmegakPlan, b: int, y: np.ndarray, prm: dict[str, Any], q: dict) -> None:
         """Steps 1-4 on the active rows of the block's 2-D spectrum ``y``, the result in y[:, :nr]."""
         k, g, raw = plan.options, plan.grid, plan.raw
         nr = plan.output_shape[1]
         fs = raw.radar.range_sampling_rate_hz
         f0 = raw.radar.carrier_frequency_hz
-        f_tau = sfft.fftfreq(plan.n_fft_r, 1.0 / fs)
-        tau0 = 2.0 * float(g.ranges[0]) / C
+        f_tau, f_eta, tau0 = prm["f_tau"], prm["f_eta"], prm["tau0"]
         out = y[:, :nr]
         # rows outside the processed band at every range are zero (as RD: their FFTs are skipped)
-        off = plan.f_bin[:, None] - q["fdc"][None, ::16]
-        off -= g.prf * np.floor(off / g.prf + 0.5)
-        active = np.any(np.abs(off) <= 0.5 * g.ba * (1.0 + 1e-9), axis=1)
+        active = prm["active"]
         out[~active] = 0.0
         edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
         chunks = [(c, min(bb, c + CHUNK)) for aa, bb in zip(edges[::2], edges[1::2], strict=True)

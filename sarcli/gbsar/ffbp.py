@@ -37,9 +37,10 @@ def _band(prof: RangeProfiles) -> tuple[float, float]:
 
 def ffbp_slant(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_length_m: float | None,
                azimuth_window: str = "hamming", knobs: FfbpKnobs | None = None,
-               stats: dict | None = None) -> np.ndarray:
+               stats: dict | None = None, device: str = "cpu") -> np.ndarray:
     """FFBP onto the slant-plane pixels ``px`` (azimuth) x ``pr`` (range R0), 2-D arrays of one shape ->
-    complex64 of that shape (module docstring; the image of :func:`sarcli.gbsar.backprojection.backproject`)."""
+    complex64 of that shape (module docstring; the image of :func:`sarcli.gbsar.backprojection.backproject`);
+    ``device``: cpu or cuda (:func:`sarcli.focus.ffbp.ffbp`)."""
     knobs = knobs or FfbpKnobs()
     px = np.asarray(px, np.float64)
     pr = np.broadcast_to(np.asarray(pr, np.float64), px.shape)
@@ -60,7 +61,7 @@ def ffbp_slant(prof: RangeProfiles, px: np.ndarray, pr: np.ndarray, antenna_leng
         t = (xs - xs[0]) / rail if rail > 0 else np.zeros_like(xs)
         weights = prof.weights * taper_at(azimuth_window, t)
     img, wsum = ffbp(prof.data, prof.first_range_m, prof.dr_m, cell, prof.wavelength_m, lam_min, pos,
-                     np.zeros(xs.size), weights, pix, pr, knobs, window, stats=stats)
+                     np.zeros(xs.size), weights, pix, pr, knobs, window, stats=stats, device=device)
     span = np.minimum(xs[-1], px + hb * pr) - np.maximum(xs[0], px - hb * pr)
     nominal = np.minimum(rail, 2.0 * hb * pr)
     frac = np.where(nominal > 0, span / np.where(nominal > 0, nominal, 1.0), 1.0)
@@ -103,10 +104,10 @@ def _covered_everywhere(prof: RangeProfiles, ant, ref, w, xs, ys, z) -> bool:
 
 def ffbp_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_range: np.ndarray | None, xs: np.ndarray,
               ys: np.ndarray, z: float, azimuth_window: str = "hamming", knobs: FfbpKnobs | None = None,
-              stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+              stats: dict | None = None, device: str = "cpu") -> tuple[np.ndarray, np.ndarray]:
     """FFBP of ``centred`` profiles onto the horizontal grid ``ys`` x ``xs`` at height ``z`` ->
     ``(image (n_y, n_x) complex64, fraction)``, the image and fraction of
-    :func:`sarcli.gbsar.backprojection.backproject_grid`."""
+    :func:`sarcli.gbsar.backprojection.backproject_grid`; ``device``: cpu or cuda."""
     knobs = knobs or FfbpKnobs()
     ant = np.ascontiguousarray(antenna_xyz, np.float64)
     ref = np.zeros(ant.shape[0]) if reference_range is None else np.ascontiguousarray(reference_range, np.float64)
@@ -118,7 +119,7 @@ def ffbp_grid(prof: RangeProfiles, antenna_xyz: np.ndarray, reference_range: np.
     pix = np.stack([gx, gy, np.full_like(gx, z)], axis=-1)
     cell, lam_min = _band(prof)
     img, _ = ffbp(prof.data, prof.first_range_m, prof.dr_m, cell, prof.wavelength_m, lam_min, ant, ref, w, pix,
-                  np.zeros(gx.shape), knobs, stats=stats)
+                  np.zeros(gx.shape), knobs, stats=stats, device=device)
     if _covered_everywhere(prof, ant, ref, w, xs, ys, z):
         used = np.full(gx.shape, total)
     else:

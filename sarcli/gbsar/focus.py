@@ -108,8 +108,8 @@ class FocusOptions:
     knobs of ``algorithm`` ffbp (:class:`sarcli.focus.ffbp.FfbpKnobs`; aperture_split 64: a rail's footprint
     apertures are short, so most of them are backprojected stop by stop, as BP does);
     ``bp_precision``: single | double, the grid backprojection kernel (float32 phasor recurrence or float64);
-    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) on the GPU
-    (:mod:`sarcli.gpu.bp_cuda`; DF and RD stay on the CPU).
+    ``device``: cpu, or cuda: the backprojections (bp, auto's bp ranges, ``grid_m``) and ffbp on the GPU
+    (:mod:`sarcli.gpu.bp_cuda`, :mod:`sarcli.gpu.ffbp_cuda`; DF and RD stay on the CPU).
     """
 
     algorithm: Literal["auto", "df", "rd", "bp", "ffbp"] = "auto"
@@ -135,9 +135,6 @@ class FocusOptions:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "device", check_device(self.device))
-        if self.device == "cuda" and self.algorithm == "ffbp":
-            raise ConfigError("ffbp runs on the CPU only (no CUDA kernels for its merge stages yet): use --device "
-                              "cpu, or --algorithm bp --device cuda")
         if self.algorithm not in ALGORITHMS:
             raise ConfigError(f"unknown algorithm '{self.algorithm}' (use {', '.join(ALGORITHMS)})")
         if self.near not in ("rd", "bp"):
@@ -255,7 +252,7 @@ def _ffbp(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions
     prof = range_compress(scan, pol, opts.range_window, opts.bp_oversample, permittivity=opts.permittivity)
     px, pr = np.meshgrid(grid.azimuths, grid.ranges[rows])
     return ffbp_slant(prof, px, pr, scan.antenna.length_azimuth_m if opts.beam_limited else None,
-                      opts.azimuth_window, opts.ffbp)
+                      opts.azimuth_window, opts.ffbp, device=opts.device)
 
 
 def _df(scan: Scan, pol: str, grid: Grid, rows: np.ndarray, opts: FocusOptions) -> tuple[np.ndarray, np.ndarray, int]:
@@ -317,12 +314,21 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     split = df_min_range(prof0.wavelength_m, rail, lx, opts.criterion_rad)
     alg = opts.algorithm
     uniform = x.size < 3 or np.allclose(np.diff(x), np.diff(x)[0], rtol=1e-6, atol=0)
+    near, near_selection = opts.near, None
+    if alg == "auto" and opts.near == "bp":  # ffbp instead where it is a GB-SAR algorithm and predicted good
+        from dataclasses import asdict
+
+        from sarcli.focus.select import gbsar_near
+
+        own = getattr(opts, "ffbp", None)  # the GB-SAR ffbp's knobs, where it has them
+        near, near_selection = gbsar_near(x.size, ALGORITHMS, opts.azimuth_window,
+                                          knobs=asdict(own) if own is not None else None)
     if alg == "auto" and not uniform:
-        alg_plan = {"bp": np.arange(grid.ranges.size)}
+        alg_plan = {near if near == "ffbp" else "bp": np.arange(grid.ranges.size)}
     elif alg == "auto":
         near_rows = np.flatnonzero(grid.ranges < split)
         far_rows = np.flatnonzero(grid.ranges >= split)
-        alg_plan = {k: v for k, v in ((opts.near, near_rows), ("df", far_rows)) if v.size}
+        alg_plan = {k: v for k, v in ((near, near_rows), ("df", far_rows)) if v.size}
     else:
         alg_plan = {alg: np.arange(grid.ranges.size)}
     amap = np.zeros((grid.ranges.size, grid.azimuths.size), np.uint8)
@@ -355,7 +361,7 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
         "algorithm": opts.algorithm,
         "used": {k: [float(grid.ranges[v][0]), float(grid.ranges[v][-1])] for k, v in alg_plan.items()},
         "df_min_range_m": split, "criterion_rad": opts.criterion_rad,
-        "near_algorithm": opts.near if opts.algorithm == "auto" else None,
+        "near_algorithm": near if opts.algorithm == "auto" else None,
         "rail_uniform": bool(uniform), "skipped_stops": sorted(int(order[i]) for i in prof0.skipped),
         "rail_reordered": bool(np.any(order != np.arange(order.size))),
         # L_x of the beam footprint |x - x_i| <= lam R0/(2 L_x) that limits each pixel's aperture
@@ -366,6 +372,8 @@ def focus_scan(scan: Scan, opts: FocusOptions | None = None, grid: Grid | None =
     }
     if opts.permittivity != 1.0:
         report["permittivity"] = opts.permittivity
+    if near_selection is not None:
+        report["near_selection"] = near_selection
     if opts.algorithm == "auto" and not uniform:
         report["note"] = "non-uniform rail steps: DF/RD impossible, the whole image was backprojected"
     df_ranges = grid.ranges[alg_plan["df"]] if "df" in alg_plan else np.zeros(0)
@@ -412,7 +420,7 @@ def focus_grid(scan: Scan, opts: FocusOptions, pols: tuple[str, ...] | None = No
             raise SarcliError("every sweep is flagged or holds NaN: nothing to focus")
         if opts.algorithm == "ffbp":
             image[ip], frac = ffbp_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
-                                        opts.azimuth_window, opts.ffbp)
+                                        opts.azimuth_window, opts.ffbp, device=opts.device)
         else:
             image[ip], frac = backproject_grid(prof, ant, scan.reference_range, plane.xs, plane.ys, plane.z,
                                                opts.azimuth_window, opts.bp_precision, opts.device)

@@ -111,5 +111,5 @@ def options_with_device(options_type: type, options: dict[str, Any], device: str
         return {**options, "device": d}
     if d == "cuda":
         raise ConfigError(f"this focuser has no CUDA path ({options_type.__name__} has no device option): use "
-                          "--device cpu, or --algorithm rd, csa or backprojection")
+                          "--device cpu, or --algorithm rd, csa, omegak, backprojection or ffbp")
     return options

@@ -114,45 +114,63 @@ def rcmc_azimuth_rows(xp: Any, s: Any, f_bin: Any, r_first: float, dr: float, r0
     return (val * (w * xp.exp(1j * ph))).astype(s.dtype)
 
 
-def focus_rows(plan: Any, b: int, data: np.ndarray, off: int, gain: np.ndarray | None, dev: Cuda) -> np.ndarray:
-    """Steps 1-5 of :mod:`sarcli.focus.rda` for block ``b`` on ``dev``: the (N x n_samples) azimuth-compressed
-    lines (host array of the plan's precision), raw lines ``data`` (times ``gain`` per line) at row ``off``."""
-    from sarcli.focus.rda import active_rows, src_inverse_rates
+def spectrum(plan: Any, data: np.ndarray, off: int, gain: np.ndarray | None, dev: Cuda) -> Any:
+    """The block's 2-D spectrum on ``dev`` (N x L, the plan's precision): raw lines ``data`` (times ``gain`` per
+    line) at row ``off``, zeros elsewhere, range FFT then azimuth FFT (:func:`sarcli.focus.rda._range_rows`)."""
+    xp = dev.xp
+    cdt = plan.h.dtype
+    rdt = np.float32 if cdt == np.complex64 else np.float64
+    block = np.asarray(data, cdt)
+    if gain is not None:
+        block = block * gain[:, None].astype(rdt)
+    y = xp.zeros((plan.n_fft_az, plan.n_fft_r), cdt)
+    y[off:off + block.shape[0], :block.shape[1]] = dev.asarray(block)
+    y = xp.fft.fft(y, axis=1)
+    return xp.fft.fft(y, axis=0).astype(cdt)
+
+
+def filter_rcmc_rows(plan: Any, b: int, y: Any, inv_k: np.ndarray, dev: Cuda) -> Any:
+    """Range filter x SRC (``inv_k`` per row; zeros: none) x Fourier upsampling, range IFFT, RCMC and azimuth
+    matched filter of the active rows of the 2-D spectrum ``y`` on ``dev``, in tiles of ``ROWS``: the
+    (N x n_samples) range-Doppler lines (:func:`sarcli.focus.rda._filter_rcmc_rows`)."""
+    from sarcli.focus.rda import active_rows
 
     xp = dev.xp
     k, g, raw = plan.options, plan.grid, plan.raw
     nr = plan.output_shape[1]
     cdt = plan.h.dtype
     rdt = np.float32 if cdt == np.complex64 else np.float64
-    n, n_fft_r = plan.n_fft_az, plan.n_fft_r
     factor = k.rcmc_oversample
-    block = np.asarray(data, cdt)
-    if gain is not None:
-        block = block * gain[:, None].astype(rdt)
-    y = xp.zeros((n, n_fft_r), cdt)
-    y[off:off + block.shape[0], :nr] = dev.asarray(block)
-    y = xp.fft.fft(y, axis=1)
-    y = xp.fft.fft(y, axis=0).astype(cdt)
     q = plan.block[b]
     geo = {key: dev.asarray(np.ascontiguousarray(q[key], np.float64)) for key in ("v", "fdc", "dt", "ph0")}
     f_bin = dev.asarray(plan.f_bin)
-    f_tau = dev.asarray(sfft.fftfreq(n_fft_r, 1.0 / raw.radar.range_sampling_rate_hz))
-    inv_k = dev.asarray(src_inverse_rates(plan, b))
+    f_tau = dev.asarray(sfft.fftfreq(plan.n_fft_r, 1.0 / raw.radar.range_sampling_rate_hz))
+    inv_k = dev.asarray(inv_k)
     h = dev.asarray(plan.h)
     wtab = dev.asarray((plan.wtab * factor).astype(rdt))
     table = dev.asarray(plan.table)
     ranges = dev.asarray(g.ranges)
     dr = C / (2.0 * raw.radar.range_sampling_rate_hz) / factor
-    out = xp.zeros((n, nr), cdt)
+    out = xp.zeros((plan.n_fft_az, nr), cdt)
     active = active_rows(plan.f_bin, q["fdc"], g.prf, g.ba)
     edges = np.flatnonzero(np.diff(np.r_[0, active.astype(np.int8), 0]))
     for first, stop in zip(edges[::2], edges[1::2], strict=True):  # runs of active rows, in tiles
         for lo in range(int(first), int(stop), ROWS):
             hi = min(int(stop), lo + ROWS)
-            up = range_filter_rows(xp, y[lo:hi], h, f_tau, inv_k[lo:hi], factor * n_fft_r)
+            up = range_filter_rows(xp, y[lo:hi], h, f_tau, inv_k[lo:hi], factor * plan.n_fft_r)
             up = xp.fft.ifft(up, axis=1).astype(cdt)
             out[lo:hi] = rcmc_azimuth_rows(xp, up, f_bin[lo:hi], float(g.ranges[0]), dr, ranges, geo["v"], geo["fdc"],
                                            geo["dt"], geo["ph0"], g.wavelength, g.prf, g.ba, wtab, plan.kind, table,
                                            g.shift)
-    img = xp.fft.ifft(out, axis=0)
-    return np.ascontiguousarray(dev.to_host(img), cdt)
+    return out
+
+
+def focus_rows(plan: Any, b: int, data: np.ndarray, off: int, gain: np.ndarray | None, dev: Cuda) -> np.ndarray:
+    """Steps 1-5 of :mod:`sarcli.focus.rda` for block ``b`` on ``dev``: the (N x n_samples) azimuth-compressed
+    lines (host array of the plan's precision), raw lines ``data`` (times ``gain`` per line) at row ``off``."""
+    from sarcli.focus.rda import src_inverse_rates
+
+    y = spectrum(plan, data, off, gain, dev)
+    out = filter_rcmc_rows(plan, b, y, src_inverse_rates(plan, b), dev)
+    img = dev.xp.fft.ifft(out, axis=0)
+    return np.ascontiguousarray(dev.to_host(img), plan.h.dtype)

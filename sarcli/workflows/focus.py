@@ -52,6 +52,9 @@ class Config:
     with looks_az x looks_rg looks, the GeoTIFFs' tiles compressed by ``geotiff_compression``
     (``sarcli.io.images.COMPRESSIONS``); channel: receive channel (0 = /echo);
     accept_unresolved_ambiguity: use a Doppler model whose PRF ambiguity is not resolved;
+    algorithm ``auto``: the cheapest registered focuser whose predicted errors on this geometry meet
+    ``quality`` (``"irw=0.02,pslr=1,phase=0.1"``, :class:`sarcli.focus.select.Quality`; default those),
+    chosen by :func:`sarcli.focus.select.choose_for` once the Doppler model is known, before focusing;
     device: cpu | cuda, the focuser's ``device`` option (None: the focuser's default, cpu);
     workers / threads_per_worker / scheduler: focus the blocks in parallel on a local Dask cluster of
     that many processes, or on the scheduler at that address (:mod:`sarcli.parallel.cluster`); they
@@ -84,11 +87,18 @@ class Config:
     scheduler: str | None = None
     radiometry: Literal["beta0", "sigma0", "gamma0"] | None = None
     noise_subtraction: bool = False
+    quality: str | None = None
 
     def __post_init__(self) -> None:
         self.cluster()  # checked when the configuration is made
         if self.radiometry is not None and self.radiometry not in ("beta0", "sigma0", "gamma0"):
             raise ConfigError(f"--radiometry must be beta0, sigma0 or gamma0, got {self.radiometry!r}")
+        if self.quality is not None:
+            if self.algorithm != "auto":
+                raise ConfigError("--quality states what --algorithm auto must meet: give --algorithm auto")
+            from sarcli.focus.select import Quality
+
+            Quality.parse(self.quality)
         if self.looks_az < 1 or self.looks_rg < 1:
             raise ConfigError(f"--looks-az and --looks-rg must be at least 1, got {self.looks_az} and {self.looks_rg}")
         if self.pixel_spacing_m is not None and not (math.isfinite(self.pixel_spacing_m) and self.pixel_spacing_m > 0):
@@ -152,6 +162,7 @@ class FocusReport(Report):
     peak_rss_bytes: int
     warnings: list[str]
     parameters: dict[str, Any]
+    selection: dict[str, Any] | None = None
 
     def lines(self) -> list[str]:
         du = self.doppler_used
@@ -161,6 +172,11 @@ class FocusReport(Report):
                f"cos(squint), median over the blocks): fdc {du['fdc_hz_mid']:.1f} Hz, "
                f"fr {du['fr_hz_per_s_mid']:.2f} Hz/s; peak RSS {self.peak_rss_bytes / 2**20:.0f} MiB"]
         out += [f"wrote {v}" for k, v in self.products.items() if k not in ("slc", "crs")]
+        if self.selection is not None:
+            p = self.selection["predicted"]
+            out.insert(0, f"auto chose {self.algorithm} {self.selection['knobs'] or ''}(predicted: IRW "
+                          f"{p['irw']:.2%}, PSLR {p['pslr_db']:.2f} dB, phase {p['phase_rad']:.3f} rad; "
+                          f"{len(self.selection['alternatives'])} alternative(s) in --json)")
         return out
 
 
@@ -223,8 +239,10 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         t_start = time.perf_counter()
         refuse_overwriting_inputs((config.raw, config.doppler, config.dem), config.outputs)
         _check_outputs(config)
-        focuser = FOCUSERS.get(config.algorithm)
-        options = options_for(focuser, options_with_device(focuser.Options, config.options, config.device))
+        auto = config.algorithm == "auto"
+        focuser: Any = None if auto else FOCUSERS.get(config.algorithm)  # auto: chosen below
+        options = None if auto else options_for(focuser, options_with_device(focuser.Options, config.options,
+                                                                              config.device))
         from sarcli.io.dem import load_terrain
         from sarcli.io.raw import raw_shape, read_raw
 
@@ -242,11 +260,14 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         load_echo = _Echo(config.raw)
 
         t0 = time.perf_counter()
-        model, how = (None, "not used") if not focuser.needs_doppler else _doppler_model(config, raw, shape, terrain,
-                                                                                        load_echo)
+        model, how = (None, "not used") if not (auto or focuser.needs_doppler) else _doppler_model(
+            config, raw, shape, terrain, load_echo)
         if model is not None and config.fdc is None:
             _refuse_unresolved(model, config)
         t_doppler = time.perf_counter() - t0
+        selection, notes = None, []
+        if auto:  # before any focusing: a refusal costs nothing but the Doppler model
+            focuser, options, selection, notes = _auto(config, raw, shape, model)
         with all_or_nothing():  # the SLC, GeoTIFFs and quicklook appear together or not at all
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
@@ -254,7 +275,7 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
                 slc, sink = _focus_to_file(config, focuser, options, raw, shape, model, terrain, load_echo,
                                            make_plan, run_blocks, progress)
                 t_focus = time.perf_counter() - t0
-            msgs = [str(w.message) for w in caught]
+            msgs = notes + [str(w.message) for w in caught]
             for m in msgs:
                 log.warning(m)
             t0 = time.perf_counter()
@@ -270,7 +291,8 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
                    "statistics_and_products_s": t_products}
         timings["total_s"] = time.perf_counter() - t_start
         return FocusReport(
-            input=str(config.raw), products=products, algorithm=config.algorithm, doppler_source=how,
+            input=str(config.raw), products=products, algorithm=focuser.name if auto else config.algorithm,
+            doppler_source=how,
             shape=[int(shape[0]), int(shape[1])],
             doppler_used={"range_m_mid": float(d.range_m[mid]),
                           "fdc_hz_min": float(np.min(d.fdc_hz)), "fdc_hz_max": float(np.max(d.fdc_hz)),
@@ -281,7 +303,33 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
                           "effective_velocity_mps_mid": float(np.median(d.velocity_mps[:, mid]))},
             image_statistics=stats, timings_s=timings,
             peak_rss_bytes=peak_rss_bytes(), warnings=msgs,
-            parameters=slc.parameters)
+            parameters=slc.parameters, selection=selection)
+
+
+def _auto(config: Config, raw, shape, model):
+    """(focuser, options, the selection's report, warnings) of ``--algorithm auto``
+    (:mod:`sarcli.focus.select`). The user's options go to the chosen focuser where its Options have
+    them (the others are named in a warning); the chosen knobs are added. Nothing meeting the quality:
+    one line, before focusing."""
+    from dataclasses import fields as dc_fields
+
+    from sarcli.errors import SarcliError
+    from sarcli.focus import FOCUSERS
+    from sarcli.focus.base import options_for
+    from sarcli.focus.select import Quality, choose_for
+
+    sel = choose_for(raw, shape, model, config.options, Quality.parse(config.quality))
+    if sel.algorithm is None:
+        raise SarcliError(sel.refusal())
+    focuser = FOCUSERS.get(sel.algorithm)
+    known = {f.name for f in dc_fields(focuser.Options)}
+    dropped = sorted(set(config.options) - known)
+    notes = [f"auto chose {sel.algorithm}, which has no option {', '.join(dropped)}: not used"] if dropped else []
+    from sarcli.gpu.device import options_with_device
+
+    kept = {**{k: v for k, v in config.options.items() if k in known}, **sel.knobs}
+    options = options_for(focuser, options_with_device(focuser.Options, kept, config.device))
+    return focuser, options, sel.to_dict(), notes
 
 
 def _refuse_unfocusable(raw, path: Path) -> None:
@@ -379,7 +427,8 @@ def _products(config: Config, slc, sink, terrain, how: str) -> dict[str, str]:
     from sarcli.io.h5common import hashing
 
     products = {"slc": str(config.output)}
-    tags = {"source_product": Path(config.output).name, "algorithm": config.algorithm, "doppler": how}
+    tags = {"source_product": Path(config.output).name, "algorithm": slc.parameters.get("algorithm", config.algorithm),
+            "doppler": how}
     geotiffs = config.geotiff or config.geotiff_slant
     with hashing([config.output] if geotiffs else []) as slc_hashed:
         if config.quicklook:

@@ -31,7 +31,11 @@ def focus(
     accept_unresolved: bool = typer.Option(False, "--accept-unresolved-ambiguity",
                                            help="Use a Doppler model whose PRF ambiguity is unresolved."),
     algorithm: str = typer.Option("rd", "--algorithm", help="Focuser: rd (Range-Doppler), backprojection, "
-                                  "ffbp (fast factorized backprojection), optical, or a plug-in."),
+                                  "ffbp (fast factorized backprojection), optical, a plug-in, or auto (the cheapest "
+                                  "whose predicted error meets --quality)."),
+    quality: str = typer.Option(None, "--quality", help="What --algorithm auto must meet, e.g. "
+                                "irw=0.02,pslr=1,phase=0.1 (the default: IRW within 2 %, PSLR within 1 dB, peak "
+                                "phase within 0.1 rad of the ideal; time=SECONDS: the longest predicted run)."),
     channel: int = typer.Option(0, "--channel", help="Receive channel to focus (0 = /echo)."),
     height: float = typer.Option(0.0, "--height", help="Terrain height above the WGS-84 ellipsoid, m (default 0)."),
     dem: Path = typer.Option(None, "--dem", help="DEM raster (any GDAL format and CRS) for the terrain."),
@@ -80,8 +84,8 @@ def focus(
     scheduler: str = typer.Option(None, "--scheduler", metavar="ADDRESS", help="Focus the blocks on this Dask "
                                   "scheduler (tcp://host:8786; the raw file must be visible to its workers)."),
     device: str = typer.Option(None, "--device", metavar="[cpu|cuda]", envvar="SARCLI_DEVICE",
-                               help="Where the focuser runs: cpu (default) or cuda (rd, csa and backprojection; needs "
-                               "a GPU and the gpu extra, docs/parallel.md)."),
+                               help="Where the focuser runs: cpu (default) or cuda (rd, csa, omegak, backprojection "
+                               "and ffbp; needs a GPU and the gpu extra, docs/parallel.md)."),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON report on stdout."),
 ) -> None:
     """Focus a stripmap raw product into a single-look complex image.
@@ -113,6 +117,8 @@ def focus(
       sarcli focus raw.h5 -o slc.h5 --device cuda    # on the GPU (pip install 'sarcli[gpu]')
 
       sarcli focus raw.h5 -o slc.h5 --geotiff sigma0.tif --radiometry sigma0 --looks-az 4
+
+      sarcli focus raw.h5 -o slc.h5 --algorithm auto --quality irw=0.02,pslr=1,phase=0.1 --json
     """
     given = {"range_window": range_window, "azimuth_window": azimuth_window, "azimuth_bandwidth": azimuth_bandwidth,
              "range_band_fraction": range_band_fraction, "rcmc": rcmc, "rcmc_oversample": rcmc_oversample,
@@ -133,7 +139,8 @@ def focus(
                     crs=crs, pixel_spacing_m=spacing,
                     looks_az=looks_az, looks_rg=looks_rg, channel=channel,
                     accept_unresolved_ambiguity=accept_unresolved, workers=workers, scheduler=scheduler,
-                    radiometry=radiometry, noise_subtraction=noise_subtraction, device=_device(device))
+                    radiometry=radiometry, noise_subtraction=noise_subtraction, device=_device(device),
+                    quality=quality)
     with progress_bar(1, label="focusing") as bar:
         def progress(label: str, done: int, total: int) -> None:
             bar.length = total

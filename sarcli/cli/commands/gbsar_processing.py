@@ -149,7 +149,7 @@ def focus_cmd(
     permittivity: float = typer.Option(1.0, "--permittivity", help="Relative permittivity of the medium: waves "
                                        "travel at c/sqrt(EPS), image ranges are distances in it (e.g. depth)."),
     device: str = typer.Option("cpu", "--device", metavar="[cpu|cuda]", envvar="SARCLI_DEVICE",
-                               help="Where backprojection runs (bp, auto's bp ranges, --grid): cpu or cuda "
+                               help="Where backprojection runs (bp, auto's bp ranges, --grid, ffbp): cpu or cuda "
                                "(a GPU and the gpu extra; DF and RD stay on the CPU)."),
     double: bool = typer.Option(False, "--double", help="--grid backprojection with the float64 kernel (the "
                                 "reference; default: float32 phasor recurrence, within 4e-5 of it)."),
