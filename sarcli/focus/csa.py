@@ -88,7 +88,6 @@ import math
 import queue
 import time
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -547,31 +546,16 @@ class ChirpScaling(RangeDoppler):
                        block_time=block_time, block=blocks, warnings=msgs, replica=replica, scaling_max=smax,
                        timings={"plan_s": time.perf_counter() - t0})
 
-    def focus_block(self, plan: CsaPlan, b: int,  # type: ignore[override]
-                    read_lines: Callable[[int, int], np.ndarray]) -> np.ndarray:
-        k, g = plan.options, plan.grid
-        n_lines, nr = plan.output_shape
-        s, e = plan.block_rows(b)
-        a, z = max(0, s - g.pad), min(n_lines, e + g.pad)
-        tm = plan.timings
-        t0 = time.perf_counter()
-        data = np.asarray(read_lines(a, z))
-        _add(tm, "io_s", t0)
-        if data.shape != (z - a, nr):
-            raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
-        gain = None if plan.gain is None else plan.gain[a:z]
-        prm = block_parameters(plan, b)
-        if k.device == "cuda":
-            from sarcli.gpu.csa_xp import focus_rows
-            from sarcli.gpu.device import require_cuda
+    def block_parameters(self, plan: CsaPlan, b: int) -> dict[str, Any]:  # type: ignore[override]
+        return block_parameters(plan, b)
 
-            t0 = time.perf_counter()
-            img = focus_rows(plan, b, data, a - (s - g.pad), gain, prm, require_cuda())
-            _add(tm, "cuda_block_s", t0)
-        else:
-            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain, prm)
-        del data
-        return self._correct_block(plan, b, img)  # type: ignore[arg-type]  # RD's attributes
+    def _focus_rows_cuda(self, plan: CsaPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
+                         gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
+        """:meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.csa_xp`)."""
+        from sarcli.gpu.csa_xp import focus_rows
+        from sarcli.gpu.device import require_cuda
+
+        return focus_rows(plan, b, data, off, gain, prm, require_cuda())
 
     def _focus_rows(self, plan: CsaPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
                     gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:

@@ -492,30 +492,16 @@ class Omegak(RangeDoppler):
                               f" = {0.5 * (g.prf - g.ba):.0f} Hz: a 2-D frequency-domain focuser cannot unwrap it;"
                               " use a narrower azimuth band or --algorithm rd")
 
-    def focus_block(self, plan: OmegakPlan, b: int, read_lines) -> np.ndarray:
-        k, g = plan.options, plan.grid
-        n_lines, nr = plan.output_shape
-        s, e = plan.block_rows(b)
-        a, z = max(0, s - g.pad), min(n_lines, e + g.pad)
-        tm = plan.timings
-        t0 = time.perf_counter()
-        data = np.asarray(read_lines(a, z))
-        _add(tm, "io_s", t0)
-        if data.shape != (z - a, nr):
-            raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
-        gain = None if plan.gain is None else plan.gain[a:z]
-        prm = block_parameters(plan, b)
-        if k.device == "cuda":
-            from sarcli.gpu.device import require_cuda
-            from sarcli.gpu.omegak_xp import focus_rows
+    def block_parameters(self, plan: OmegakPlan, b: int) -> dict[str, Any]:  # type: ignore[override]
+        return block_parameters(plan, b)
 
-            t0 = time.perf_counter()
-            img = focus_rows(plan, b, data, a - (s - g.pad), gain, prm, require_cuda())
-            _add(tm, "cuda_block_s", t0)
-        else:
-            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain, prm)
-        del data
-        return self._correct_block(plan, b, img)
+    def _focus_rows_cuda(self, plan: OmegakPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
+                         gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
+        """:meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.omegak_xp`)."""
+        from sarcli.gpu.device import require_cuda
+        from sarcli.gpu.omegak_xp import focus_rows
+
+        return focus_rows(plan, b, data, off, gain, prm, require_cuda())
 
     def _focus_rows(self, plan: OmegakPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
                     gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:

@@ -674,21 +674,34 @@ class RangeDoppler:
         if data.shape != (z - a, nr):
             raise SarcliError(f"echo block has shape {data.shape}, expected {(z - a, nr)}")
         gain = None if plan.gain is None else plan.gain[a:z]
+        prm = self.block_parameters(plan, b)
         if k.device == "cuda":
-            from sarcli.gpu.device import require_cuda
-            from sarcli.gpu.rd_xp import focus_rows
-
             t0 = time.perf_counter()
-            img = focus_rows(plan, b, data, a - (s - g.pad), gain, require_cuda())
+            img = self._focus_rows_cuda(plan, b, data, a - (s - g.pad), gain, prm)
             _add(tm, "cuda_block_s", t0)
         else:
-            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain)
+            img = self._focus_rows(plan, b, data, a - (s - g.pad), gain, prm)
         del data
         return self._correct_block(plan, b, img)
 
-    def _focus_rows(self, plan: RdPlan, b: int, data: np.ndarray, off: int, gain: np.ndarray | None) -> np.ndarray:
+    def block_parameters(self, plan: RdPlan, b: int) -> dict[str, Any]:
+        """What block ``b``'s steps need besides the echo, computed once on the host for the CPU and the GPU path:
+        for RD the SRC's inverse rates per azimuth-frequency bin (``inv_k``)."""
+        return {"inv_k": src_inverse_rates(plan, b)}
+
+    def _focus_rows_cuda(self, plan: RdPlan, b: int, data: np.ndarray, off: int, gain: np.ndarray | None,
+                         prm: dict[str, Any]) -> np.ndarray:
+        """The CPU's :meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.rd_xp`)."""
+        from sarcli.gpu.device import require_cuda
+        from sarcli.gpu.rd_xp import focus_rows
+
+        return focus_rows(plan, b, data, off, gain, prm, require_cuda())
+
+    def _focus_rows(self, plan: RdPlan, b: int, data: np.ndarray, off: int, gain: np.ndarray | None,
+                    prm: dict[str, Any]) -> np.ndarray:
         """Steps 1-5 of the module docstring on the CPU: the block's (N x n_samples) azimuth-compressed lines,
-        raw lines ``data`` placed at row ``off`` of the block."""
+        raw lines ``data`` placed at row ``off`` of the block, with the host parameters ``prm``
+        (:meth:`block_parameters`)."""
         k, g, raw = plan.options, plan.grid, plan.raw
         nr = plan.output_shape[1]
         tm = plan.timings
@@ -701,7 +714,7 @@ class RangeDoppler:
         _add(tm, "azimuth_fft_s", t0)
         q = plan.block[b]
         t0 = time.perf_counter()
-        _filter_rcmc_rows(y, nr, plan.h, src_inverse_rates(plan, b), plan.f_bin, g, raw.radar.range_sampling_rate_hz,
+        _filter_rcmc_rows(y, nr, plan.h, prm["inv_k"], plan.f_bin, g, raw.radar.range_sampling_rate_hz,
                           k.rcmc_oversample, q["v"], q["fdc"], q["dt"], q["ph0"], plan.wtab, plan.kind, plan.table,
                           k.workers)
         _add(tm, "range_filter_rcmc_azimuth_s", t0)

@@ -165,12 +165,12 @@ def filter_rcmc_rows(plan: Any, b: int, y: Any, inv_k: np.ndarray, dev: Cuda) ->
     return out
 
 
-def focus_rows(plan: Any, b: int, data: np.ndarray, off: int, gain: np.ndarray | None, dev: Cuda) -> np.ndarray:
+def focus_rows(plan: Any, b: int, data: np.ndarray, off: int, gain: np.ndarray | None, prm: dict[str, Any],
+               dev: Cuda) -> np.ndarray:
     """Steps 1-5 of :mod:`sarcli.focus.rda` for block ``b`` on ``dev``: the (N x n_samples) azimuth-compressed
-    lines (host array of the plan's precision), raw lines ``data`` (times ``gain`` per line) at row ``off``."""
-    from sarcli.focus.rda import src_inverse_rates
-
+    lines (host array of the plan's precision), raw lines ``data`` (times ``gain`` per line) at row ``off``,
+    ``prm`` the host parameters both paths share (:meth:`sarcli.focus.rda.RangeDoppler.block_parameters`)."""
     y = spectrum(plan, data, off, gain, dev)
-    out = filter_rcmc_rows(plan, b, y, src_inverse_rates(plan, b), dev)
+    out = filter_rcmc_rows(plan, b, y, prm["inv_k"], dev)
     img = dev.xp.fft.ifft(out, axis=0)
     return np.ascontiguousarray(dev.to_host(img), plan.h.dtype)
