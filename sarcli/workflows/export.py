@@ -142,7 +142,10 @@ NISAR_RSLC = NisarRslcFormat()
 class Config:
     """input: a sarcli SLC or a NISAR RSLC; output: the file to write; format: a name in FORMATS;
     options: that format's options; frequency/polarization: the layer of a NISAR RSLC input (a
-    sarcli SLC has one: polarization then names it in the output)."""
+    sarcli SLC has one: polarization then names it in the output); radiometry: write calibrated
+    backscatter (beta0, sigma0, gamma0 on the ellipsoid) in dB instead of the complex samples, for a
+    format whose options take it (envi); nisar-rslc and sicd refuse it, as they carry the beta0, sigma0,
+    gamma0 and noise tables themselves whenever the SLC has ``/calibration``."""
 
     input: Path
     output: Path
@@ -150,6 +153,7 @@ class Config:
     options: dict[str, Any] = field(default_factory=dict)
     frequency: str | None = None
     polarization: str | None = None
+    radiometry: Literal["beta0", "sigma0", "gamma0"] | None = None
 
 
 @dataclass
@@ -190,6 +194,11 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
     from sarcli.io.nisar.rslc import read_image, sniff_rslc
 
     fmt = FORMATS.get(config.format)  # an unknown format is refused before any reading
+    takes_radiometry = "radiometry" in getattr(fmt.Options, "__dataclass_fields__", {})
+    if config.radiometry is not None and not takes_radiometry:
+        raise ConfigError(f"--radiometry has no meaning for --format {config.format}: it writes the complex "
+                          "samples (nisar-rslc and sicd carry the beta0, sigma0, gamma0 and noise tables whenever "
+                          "the SLC is calibrated); a calibrated image: --format envi")
     refuse_overwriting_inputs([config.input], [config.output])
     with using(provenance):
         # polarization: the layer to read from an RSLC; for a sarcli SLC (one layer) the name it gets
@@ -202,6 +211,11 @@ def run(config: Config, provenance: Provenance | None = None, progress: Progress
         layer = config.polarization or (slc.parameters or {}).get("nisar", {}).get("polarization")
         if layer is not None and "polarization" in getattr(fmt.Options, "__dataclass_fields__", {}):
             options.setdefault("polarization", layer)  # an RSLC layer keeps its name
+        if config.radiometry is not None:
+            if slc.calibration is None:
+                raise ConfigError(f"--radiometry {config.radiometry}: {config.input} carries no radiometric "
+                                  "calibration (no /calibration: focus it again with this sarcli)")
+            options["radiometry"] = config.radiometry
         details = write_format(slc, config.output, config.format, options, (config.input,))
         if progress is not None:
             progress("export", 1, 1)

@@ -29,6 +29,16 @@ SLC also has its lines reversed: SICD's column axis must make the grid normal po
 - IRW: the -3 dB width of the transform of the processing window (sarcli's ``range_window`` /
   ``azimuth_window``) over the processed band, divided by ImpRespBW.
 - SCPCOA: sarkit's own computation from the above (``compute_scp_coa``), so it is consistent by construction.
+- Radiometric (written whenever the SLC carries ``/calibration``; SICD Vol. 1, [NGA-SICD]): SICD's scale
+  factors multiply pixel power as NISAR's look-up tables do (beta0 = |DN|^2 L_beta0,
+  :mod:`sarcli.calibration.radiometry`), so BetaZeroSFPoly, SigmaZeroSFPoly and GammaZeroSFPoly (ellipsoid
+  incidence) are 2-D polynomials in (xrow, ycol) fitted to L_beta0, L_sigma0, L_gamma0 on a 48 x 48 grid of
+  the image's pixels (least squares in relative error, the lowest degree of (2, 1) ... (6, 3) within
+  0.01 dB, else (6, 3); over the calibrated pixels: outside the product's calibrated area the
+  polynomial is an extrapolation). RCSSFPoly = BetaZeroSFPoly / (Row.ImpRespBW Col.ImpRespBW), the
+  divisor SICD's slant-plane area of a pixel without a WgtFunct: RCS = RCSSF x the integrated pixel power. NoiseLevel
+  (ABSOLUTE): NoisePoly the noise power of a pixel in dB, 10 log10(NESZ / L_sigma0), fitted in dB, when
+  the product has a noise floor. The largest misfit on the grid is reported (``radiometric_fit_db``).
 
 The writer refuses (one line) an SLC without an Earth orbit (none, or LOCAL) or without its processed
 bandwidths. ``sarkit`` is an optional dependency (``pip install 'sarcli[sicd]'``).
@@ -115,7 +125,8 @@ class SicdFormat:
     Options = SicdOptions
 
     def xml(self, slc: SLC, options: SicdOptions):
-        """The SICD XML tree (lxml) and the pixel array (complex64, SICD rows = ranges) of ``slc``."""
+        """The SICD XML tree (lxml), the pixel array (complex64, SICD rows = ranges) of ``slc`` and the
+        largest misfits (dB) of its radiometric polynomials (empty without calibration)."""
         import lxml.etree
 
         sksicd = sarkit_sicd()
@@ -256,14 +267,22 @@ class SicdFormat:
         tree = root.elem.getroottree()
         scpcoa = sksicd.compute_scp_coa(tree)
         root.elem.insert(list(root.elem).index(root["ImageFormation"].elem) + 1, scpcoa)
-        return tree, pixels
+        fit_db: dict[str, float] = {}
+        if slc.calibration is not None:
+            radiometric, fit_db = radiometric_polys(slc, r_s, t_s, dt, col_ss * side, row_bw * col_bw)
+            if radiometric:
+                root["Radiometric"] = radiometric
+                elem = root["Radiometric"].elem
+                root.elem.remove(elem)  # SICD's order: SCPCOA, then Radiometric
+                root.elem.insert(list(root.elem).index(scpcoa) + 1, elem)
+        return tree, pixels, fit_db
 
     def write(self, slc: SLC, output: Path, options: SicdOptions, inputs: tuple[Path, ...]) -> dict[str, Any]:
         from sarcli.io.atomic import atomic_path
 
         sksicd = sarkit_sicd()
 
-        tree, pixels = self.xml(slc, options)
+        tree, pixels, fit_db = self.xml(slc, options)
         clas = options.classification[0].upper()
         sec = {"security": {"clas": clas}}
         meta = sksicd.NitfMetadata(
@@ -275,7 +294,67 @@ class SicdFormat:
         return {"rows": int(pixels.shape[0]), "cols": int(pixels.shape[1]),
                 "scp_lat_lon_hae": [float(tree.findtext(f"{{*}}GeoData/{{*}}SCP/{{*}}LLH/{{*}}{k}"))
                                     for k in ("Lat", "Lon", "HAE")],
-                "col_ss_m": float(tree.findtext("{*}Grid/{*}Col/{*}SS"))}
+                "col_ss_m": float(tree.findtext("{*}Grid/{*}Col/{*}SS")),
+                **({"radiometric_fit_db": fit_db} if fit_db else {})}
+
+
+FIT_DEGREES = ((2, 1), (3, 1), (4, 2), (5, 2), (6, 3))
+FIT_TOLERANCE_DB = 0.01
+
+
+def _sf_fit(xx: np.ndarray, yy: np.ndarray, lut: np.ndarray) -> tuple[np.ndarray, float]:
+    """A scale-factor polynomial c[i, j] (x^i y^j) fitted to the positive values ``lut`` (least squares in
+    relative error) and its largest misfit in dB: the lowest degree of FIT_DEGREES within
+    FIT_TOLERANCE_DB, else the highest."""
+    sx, sy = max(float(np.max(np.abs(xx))), 1e-12), max(float(np.max(np.abs(yy))), 1e-12)
+    best = None
+    for dx, dy in FIT_DEGREES:
+        a = np.stack([(xx / sx) ** i * (yy / sy) ** j for i in range(dx + 1) for j in range(dy + 1)], axis=-1)
+        c, *_ = np.linalg.lstsq(a / lut[:, None], np.ones_like(lut), rcond=None)
+        fit = a @ c
+        err = float(np.max(np.abs(10 * np.log10(np.maximum(fit, 1e-300) / lut))))
+        best = (c.reshape(dx + 1, dy + 1) / (sx ** np.arange(dx + 1))[:, None] / (sy ** np.arange(dy + 1))[None, :],
+                err)
+        if err <= FIT_TOLERANCE_DB:
+            break
+    return best
+
+
+def radiometric_polys(slc: SLC, r_s: float, t_s: float, dt: float, col_per_line: float,
+                      bw_area: float) -> tuple[dict[str, Any], dict[str, float]]:
+    """SICD's Radiometric block of ``slc``'s look-up tables (module docstring) and the fits' largest
+    misfits (dB); empty when no pixel is calibrated. ``col_per_line``: ycol (m) per line after t_s
+    (signed); ``bw_area``: Row.ImpRespBW x Col.ImpRespBW (1/m^2)."""
+    from sarcli.calibration.radiometry import lut_on
+
+    cal = slc.calibration
+    n_az, n_r = slc.image.shape
+    i = np.unique(np.linspace(0, n_az - 1, 48).round().astype(int))
+    j = np.unique(np.linspace(0, n_r - 1, 48).round().astype(int))
+    t, r = np.asarray(slc.azimuth_time, np.float64)[i], np.asarray(slc.slant_range, np.float64)[j]
+    xx, yy = np.meshgrid(r - r_s, (t - t_s) / dt * col_per_line, indexing="ij")  # (range, line) as SICD
+    luts = {k: lut_on(cal, k, t, r).T for k in ("beta0", "sigma0", "gamma0", "nes0")}
+    ok = np.isfinite(luts["beta0"]) & (luts["beta0"] > 0)
+    if not ok.any():
+        return {}, {}
+    out, err = {}, {}
+    for k in ("beta0", "sigma0", "gamma0"):
+        good = ok & np.isfinite(luts[k]) & (luts[k] > 0)
+        c, err[k] = _sf_fit(xx[good], yy[good], luts[k][good])
+        out[{"beta0": "BetaZero", "sigma0": "SigmaZero", "gamma0": "GammaZero"}[k] + "SFPoly"] = c
+    radiometric = {"RCSSFPoly": out["BetaZeroSFPoly"] / bw_area, "SigmaZeroSFPoly": out["SigmaZeroSFPoly"],
+                   "BetaZeroSFPoly": out["BetaZeroSFPoly"], "GammaZeroSFPoly": out["GammaZeroSFPoly"]}  # SICD's order
+    noise = luts["nes0"] / luts["sigma0"]
+    good = ok & np.isfinite(noise) & (noise > 0)
+    if good.any():
+        db = 10 * np.log10(noise[good])
+        for dx, dy in FIT_DEGREES:
+            c = _poly2(xx[good], yy[good], db, dx, dy)
+            err["noise"] = float(np.max(np.abs(np.polynomial.polynomial.polyval2d(xx[good], yy[good], c) - db)))
+            if err["noise"] <= FIT_TOLERANCE_DB:
+                break
+        radiometric = {"NoiseLevel": {"NoiseLevelType": "ABSOLUTE", "NoisePoly": c}, **radiometric}
+    return radiometric, err
 
 
 SICD = SicdFormat()

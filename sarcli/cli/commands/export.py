@@ -42,6 +42,10 @@ def export(
     option: list[str] = typer.Option(None, "--option", help="Format option KEY=VALUE, repeatable "
                                      "(nisar-rslc: frequency, mission_id, instrument, compression; sicd: "
                                      "collector, classification; envi: gcps)."),
+    radiometry: str = typer.Option(None, "--radiometry", metavar="[beta0|sigma0|gamma0]",
+                                   help="envi: write that calibrated backscatter in dB (float32, NaN where not "
+                                        "calibrated) instead of the complex samples; the SLC must carry "
+                                        "/calibration (a SICD and an RSLC carry all the tables anyway)."),
     as_json: bool = typer.Option(False, "--json", help="Print the report as JSON on stdout."),
 ) -> None:
     """Write a focused image in an interchange format; sarcli's own SLC stays the working format.
@@ -66,6 +70,8 @@ def export(
       sarcli export slc.h5 --format sicd -o slc.nitf
 
       sarcli export slc.h5 --format envi -o slc.img
+
+      sarcli export slc.h5 --format envi --radiometry sigma0 -o sigma0.img
     """
     from sarcli.config import from_mapping
     from sarcli.workflows.export import Config, run
@@ -74,7 +80,8 @@ def export(
     cfg = from_mapping(Config, {"input": str(source), "output": str(output), "format": fmt,
                                 "options": _options(option or []),
                                 **({"polarization": polarization} if polarization else {}),
-                                **({"frequency": frequency} if frequency else {})}, "export")
+                                **({"frequency": frequency} if frequency else {}),
+                                **({"radiometry": radiometry} if radiometry else {})}, "export")
     report = run(cfg)
     if as_json:
         emit_json(report.to_dict())
