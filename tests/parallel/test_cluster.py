@@ -20,7 +20,8 @@ import h5py
 import numpy as np
 import pytest
 
-SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch_long.toml"  # longer than its aperture: GeoTIFFs hold pixels
+#: longer than its synthetic aperture, so that the GeoTIFFs hold fully focused lines
+SCENE = Path(__file__).parents[1] / "focus" / "scenes" / "batch_long.toml"
 BIN = Path(sys.executable).parent
 
 
