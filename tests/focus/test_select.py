@@ -119,7 +119,10 @@ def test_model_against_measurement(case):
     measured_ok = (max(abs(m["irw_range"]), abs(m["irw_azimuth"])) <= q.irw
                    and max(abs(m["pslr_range_db"]), abs(m["pslr_azimuth_db"])) <= q.pslr_db
                    and abs(m["phase_rad"]) <= q.phase_rad)
-    assert measured_ok == meets(p, q)
+    if p.get("validated", True):
+        assert measured_ok == meets(p, q)
+    else:  # beyond the squint the map validated on an orbit, auto does not rely on the model: never "meets"
+        assert not meets(p, q)
 
 
 @pytest.mark.slow
