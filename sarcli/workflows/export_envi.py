@@ -114,6 +114,8 @@ def _pixels(slc: SLC, kind: str | None, stem: str) -> tuple[np.ndarray, str, str
     from sarcli.calibration.radiometry import calibrated_intensity
 
     cal = slc.calibration
+    if cal is None:  # the workflow refuses an uncalibrated SLC before this
+        raise ProductError("the SLC has no /calibration: focus it again to write calibrated backscatter")
     inten = np.abs(np.asarray(slc.image, np.complex64)).astype(np.float64) ** 2
     lin = calibrated_intensity(slc, inten, 1, 1, kind)
     with np.errstate(divide="ignore", invalid="ignore"):

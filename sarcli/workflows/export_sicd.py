@@ -46,6 +46,7 @@ bandwidths. ``sarkit`` is an optional dependency (``pip install 'sarcli[sicd]'``
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -307,7 +308,7 @@ def _sf_fit(xx: np.ndarray, yy: np.ndarray, lut: np.ndarray) -> tuple[np.ndarray
     relative error) and its largest misfit in dB: the lowest degree of FIT_DEGREES within
     FIT_TOLERANCE_DB, else the highest."""
     sx, sy = max(float(np.max(np.abs(xx))), 1e-12), max(float(np.max(np.abs(yy))), 1e-12)
-    best = None
+    best: tuple[np.ndarray, float] = (np.zeros((1, 1)), math.inf)
     for dx, dy in FIT_DEGREES:
         a = np.stack([(xx / sx) ** i * (yy / sy) ** j for i in range(dx + 1) for j in range(dy + 1)], axis=-1)
         c, *_ = np.linalg.lstsq(a / lut[:, None], np.ones_like(lut), rcond=None)
@@ -328,6 +329,8 @@ def radiometric_polys(slc: SLC, r_s: float, t_s: float, dt: float, col_per_line:
     from sarcli.calibration.radiometry import lut_on
 
     cal = slc.calibration
+    if cal is None:
+        return {}, {}
     n_az, n_r = slc.image.shape
     i = np.unique(np.linspace(0, n_az - 1, 48).round().astype(int))
     j = np.unique(np.linspace(0, n_r - 1, 48).round().astype(int))
@@ -337,13 +340,15 @@ def radiometric_polys(slc: SLC, r_s: float, t_s: float, dt: float, col_per_line:
     ok = np.isfinite(luts["beta0"]) & (luts["beta0"] > 0)
     if not ok.any():
         return {}, {}
-    out, err = {}, {}
+    out: dict[str, np.ndarray] = {}
+    err: dict[str, float] = {}
     for k in ("beta0", "sigma0", "gamma0"):
         good = ok & np.isfinite(luts[k]) & (luts[k] > 0)
         c, err[k] = _sf_fit(xx[good], yy[good], luts[k][good])
         out[{"beta0": "BetaZero", "sigma0": "SigmaZero", "gamma0": "GammaZero"}[k] + "SFPoly"] = c
-    radiometric = {"RCSSFPoly": out["BetaZeroSFPoly"] / bw_area, "SigmaZeroSFPoly": out["SigmaZeroSFPoly"],
-                   "BetaZeroSFPoly": out["BetaZeroSFPoly"], "GammaZeroSFPoly": out["GammaZeroSFPoly"]}  # SICD's order
+    radiometric: dict[str, Any] = {  # SICD's order
+        "RCSSFPoly": out["BetaZeroSFPoly"] / bw_area, "SigmaZeroSFPoly": out["SigmaZeroSFPoly"],
+        "BetaZeroSFPoly": out["BetaZeroSFPoly"], "GammaZeroSFPoly": out["GammaZeroSFPoly"]}
     noise = luts["nes0"] / luts["sigma0"]
     good = ok & np.isfinite(noise) & (noise > 0)
     if good.any():
