@@ -174,7 +174,8 @@ class FocusReport(Report):
         out += [f"wrote {v}" for k, v in self.products.items() if k not in ("slc", "crs")]
         if self.selection is not None:
             p = self.selection["predicted"]
-            out.insert(0, f"auto chose {self.algorithm} {self.selection['knobs'] or ''}(predicted: IRW "
+            knobs = ", ".join(f"{k}={v}" for k, v in (self.selection["knobs"] or {}).items())
+            out.insert(0, f"auto chose {self.algorithm}{f' ({knobs})' if knobs else ''} (predicted: IRW "
                           f"{p['irw']:.2%}, PSLR {p['pslr_db']:.2f} dB, phase {p['phase_rad']:.3f} rad; "
                           f"{len(self.selection['alternatives'])} alternative(s) in --json)")
         return out
