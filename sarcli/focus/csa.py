@@ -546,16 +546,8 @@ class ChirpScaling(RangeDoppler):
                        block_time=block_time, block=blocks, warnings=msgs, replica=replica, scaling_max=smax,
                        timings={"plan_s": time.perf_counter() - t0})
 
-    def block_parameters(self, plan: CsaPlan, b: int) -> dict[str, Any]:  # type: ignore[override]
-        return block_parameters(plan, b)
-
-    def _focus_rows_cuda(self, plan: CsaPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
-                         gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
-        """:meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.csa_xp`)."""
-        from sarcli.gpu.csa_xp import focus_rows
-        from sarcli.gpu.device import require_cuda
-
-        return focus_rows(plan, b, data, off, gain, prm, require_cuda())
+    block_parameters = staticmethod(block_parameters)  # type: ignore[assignment]  # the host parameters
+    gpu_block = "csa_xp"
 
     def _focus_rows(self, plan: CsaPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
                     gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:

@@ -108,7 +108,6 @@ from sarcli.focus.rda import (
     _filter_rcmc_rows,
     _n_threads,
     _pooled,
-    _range_rows,
     active_rows,
     smooth_len,
 )
@@ -492,16 +491,8 @@ class Omegak(RangeDoppler):
                               f" = {0.5 * (g.prf - g.ba):.0f} Hz: a 2-D frequency-domain focuser cannot unwrap it;"
                               " use a narrower azimuth band or --algorithm rd")
 
-    def block_parameters(self, plan: OmegakPlan, b: int) -> dict[str, Any]:  # type: ignore[override]
-        return block_parameters(plan, b)
-
-    def _focus_rows_cuda(self, plan: OmegakPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
-                         gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
-        """:meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.omegak_xp`)."""
-        from sarcli.gpu.device import require_cuda
-        from sarcli.gpu.omegak_xp import focus_rows
-
-        return focus_rows(plan, b, data, off, gain, prm, require_cuda())
+    block_parameters = staticmethod(block_parameters)  # type: ignore[assignment]  # the host parameters
+    gpu_block = "omegak_xp"
 
     def _focus_rows(self, plan: OmegakPlan, b: int, data: np.ndarray, off: int,  # type: ignore[override]
                     gain: np.ndarray | None, prm: dict[str, Any]) -> np.ndarray:
@@ -510,13 +501,7 @@ class Omegak(RangeDoppler):
         k, g, raw = plan.options, plan.grid, plan.raw
         nr = plan.output_shape[1]
         tm = plan.timings
-        t0 = time.perf_counter()
-        y = np.empty((plan.n_fft_az, plan.n_fft_r), plan.h.dtype)
-        _range_rows(y, off, data, gain, k.workers)
-        _add(tm, "range_fft_s", t0)
-        t0 = time.perf_counter()
-        _fft_inplace(y, 0, False, k.workers)
-        _add(tm, "azimuth_fft_s", t0)
+        y = self._spectrum(plan, data, off, gain)
         q = plan.block[b]
         f_eta, f_tau = prm["f_eta"], prm["f_tau"]
         t0 = time.perf_counter()

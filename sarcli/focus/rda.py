@@ -689,13 +689,32 @@ class RangeDoppler:
         for RD the SRC's inverse rates per azimuth-frequency bin (``inv_k``)."""
         return {"inv_k": src_inverse_rates(plan, b)}
 
+    #: the module of :mod:`sarcli.gpu` that holds this focuser's block on the array namespace (``focus_rows``)
+    gpu_block = "rd_xp"
+
     def _focus_rows_cuda(self, plan: RdPlan, b: int, data: np.ndarray, off: int, gain: np.ndarray | None,
                          prm: dict[str, Any]) -> np.ndarray:
-        """The CPU's :meth:`_focus_rows` on the GPU (:mod:`sarcli.gpu.rd_xp`)."""
-        from sarcli.gpu.device import require_cuda
-        from sarcli.gpu.rd_xp import focus_rows
+        """The CPU's :meth:`_focus_rows` on the GPU (``sarcli.gpu.<gpu_block>.focus_rows``)."""
+        import importlib
 
+        from sarcli.gpu.device import require_cuda
+
+        focus_rows = importlib.import_module(f"sarcli.gpu.{self.gpu_block}").focus_rows
         return focus_rows(plan, b, data, off, gain, prm, require_cuda())
+
+    @staticmethod
+    def _spectrum(plan: RdPlan, data: np.ndarray, off: int, gain: np.ndarray | None) -> np.ndarray:
+        """Steps 1-2 on the CPU: the block's 2-D spectrum (N x L), raw lines ``data`` (times ``gain``) at row
+        ``off``."""
+        k, tm = plan.options, plan.timings
+        t0 = time.perf_counter()
+        y = np.empty((plan.n_fft_az, plan.n_fft_r), plan.h.dtype)
+        _range_rows(y, off, data, gain, k.workers)
+        _add(tm, "range_fft_s", t0)
+        t0 = time.perf_counter()
+        _fft_inplace(y, 0, False, k.workers)
+        _add(tm, "azimuth_fft_s", t0)
+        return y
 
     def _focus_rows(self, plan: RdPlan, b: int, data: np.ndarray, off: int, gain: np.ndarray | None,
                     prm: dict[str, Any]) -> np.ndarray:
@@ -705,13 +724,7 @@ class RangeDoppler:
         k, g, raw = plan.options, plan.grid, plan.raw
         nr = plan.output_shape[1]
         tm = plan.timings
-        t0 = time.perf_counter()
-        y = np.empty((plan.n_fft_az, plan.n_fft_r), plan.h.dtype)
-        _range_rows(y, off, data, gain, k.workers)
-        _add(tm, "range_fft_s", t0)
-        t0 = time.perf_counter()
-        _fft_inplace(y, 0, False, k.workers)
-        _add(tm, "azimuth_fft_s", t0)
+        y = self._spectrum(plan, data, off, gain)
         q = plan.block[b]
         t0 = time.perf_counter()
         _filter_rcmc_rows(y, nr, plan.h, prm["inv_k"], plan.f_bin, g, raw.radar.range_sampling_rate_hz,
