@@ -20,6 +20,7 @@ Without a client the same tasks run in order in this process (same functions, sa
 from __future__ import annotations
 
 import logging
+import threading
 import time
 import uuid
 import warnings
@@ -104,15 +105,47 @@ def _run(fn: Callable[..., Any], threads_by_host: Mapping[str, int], n_args: int
     if _worker_address():
         _quiet_logging()
     t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            with task_threads(threads_by_host):
-                value = fn(*own, *(up.value for up in upstream))
-        except (SarcliError, OrbitError) as e:
-            return _Result("failed", error=one_line(e), seconds=time.perf_counter() - t0, worker=_worker_address(),
-                           warnings=_lines(caught))
+    _install_warning_sink()
+    caught: list[warnings.WarningMessage] = []
+    _sink.caught = caught
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("always")
+            try:
+                with task_threads(threads_by_host):
+                    value = fn(*own, *(up.value for up in upstream))
+            except (SarcliError, OrbitError) as e:
+                return _Result("failed", error=one_line(e), seconds=time.perf_counter() - t0,
+                               worker=_worker_address(), warnings=_lines(caught))
+    finally:
+        _sink.caught = None
     return _Result("done", value, seconds=time.perf_counter() - t0, worker=_worker_address(), warnings=_lines(caught))
+
+
+#: the warnings of the task running on this thread (None: not in a task)
+_sink = threading.local()
+_sink_lock = threading.Lock()
+
+
+def _install_warning_sink() -> None:
+    """Route each thread's warnings to its own task (``_sink.caught``). ``catch_warnings(record=True)`` swaps
+    the process-wide ``warnings.showwarning``: tasks on two threads would restore each other's and lose or
+    swap their warnings. This hook is installed once (again if someone replaced it since) and hands a
+    warning raised outside any task to the function it replaced."""
+    with _sink_lock:
+        current = warnings.showwarning
+        if getattr(current, "_sarcli_task_sink", False):
+            return
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            caught = getattr(_sink, "caught", None)
+            if caught is None:
+                current(message, category, filename, lineno, file, line)
+            else:
+                caught.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
+
+        show._sarcli_task_sink = True  # type: ignore[attr-defined]
+        warnings.showwarning = show
 
 
 def _quiet_logging() -> None:
