@@ -35,7 +35,10 @@ KNOBS = [("default (base 4, beta 2, 6 x 6 taps, U 2)", FfbpKnobs()),
          ("beta 3, 8 x 8 taps, U 3", FfbpKnobs(oversample=3.0, order=8, range_order=8, range_oversample=3.0))]
 
 
-def _compare(bp: np.ndarray, ff: np.ndarray, cells) -> dict:
+def compare_images(bp: np.ndarray, ff: np.ndarray, cells) -> dict:
+    """``ff`` against the reference ``bp`` at the point-like returns ``cells`` (row, column): the largest peak
+    position difference (pixels), PSLR difference (dB, both cuts), relative amplitude and phase differences,
+    and the largest difference over the image (of the reference's peak)."""
     mb = [point_target_metrics(bp, *c, half=32) for c in cells]
     mf = [point_target_metrics(ff, *c, half=32) for c in cells]
     pairs = list(zip(mf, mb, strict=True))
@@ -48,7 +51,9 @@ def _compare(bp: np.ndarray, ff: np.ndarray, cells) -> dict:
             "max_difference": float(np.abs(ff - bp).max() / np.abs(bp).max())}
 
 
-def _point_like(img: np.ndarray, n: int = 12, apart: int = 40) -> list[tuple[int, int]]:
+def point_like(img: np.ndarray, n: int = 12, apart: int = 40) -> list[tuple[int, int]]:
+    """The ``n`` brightest local maxima ``apart`` pixels apart (and from the edges) whose PSLR is below -13 dB
+    along both cuts (isolated point-like returns)."""
     a = np.abs(img)
     cells: list[tuple[int, int]] = []
     for k in np.argsort(a, axis=None)[::-1]:
@@ -81,14 +86,14 @@ def bench_gotcha() -> dict | None:
     xs = np.arange(-50.0, 50.0 + 1e-9, 0.1)
     bp, _ = backproject_grid(prof, ant, ref, xs, xs, 0.0, "hamming")
     t_bp = best_time(lambda: backproject_grid(prof, ant, ref, xs, xs, 0.0, "hamming"), repeat=2, warmup=0)
-    cells = _point_like(bp)
+    cells = point_like(bp)
     rows = []
     for name, kn in KNOBS:
         stats: dict = {}
         ff, _ = ffbp_grid(prof, ant, ref, xs, xs, 0.0, "hamming", kn, stats=stats)
         t = best_time(lambda kn=kn: ffbp_grid(prof, ant, ref, xs, xs, 0.0, "hamming", kn), repeat=2, warmup=0)
         rows.append({"knobs": name, "seconds": t, "bp_over_ffbp": t_bp / t, "merge_stages": stats["merge_stages"],
-                     "polar_samples": stats["polar_samples"], **_compare(bp, ff, cells)})
+                     "polar_samples": stats["polar_samples"], **compare_images(bp, ff, cells)})
     return {"pixels": [xs.size, xs.size], "pulses": int(ant.shape[0]), "bp_seconds": t_bp, "points": cells,
             "rows": rows}
 
@@ -130,7 +135,7 @@ def bench_stripmap() -> dict:
         ff = focus_ffbp(raw, dop, **win, **kw)
         t = time.perf_counter() - t0
         rows.append({"knobs": name, "seconds": t, "bp_over_ffbp": t_bp / t,
-                     "top_lines": ff.parameters["ffbp_top_lines"], **_compare(bp.image, ff.image, [(128, 128)])})
+                     "top_lines": ff.parameters["ffbp_top_lines"], **compare_images(bp.image, ff.image, [(128, 128)])})
     return {"pixels": [256, 256], "aperture_lines": ff.parameters["ffbp_aperture_lines"], "bp_seconds": t_bp,
             "rows": rows}
 

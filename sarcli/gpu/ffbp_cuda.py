@@ -1,8 +1,9 @@
 """Fast factorized backprojection on CUDA (numba.cuda): the stage-0, merge and last-stage kernels of
-:mod:`sarcli.focus.ffbp` [UlaHelSte2003], one thread per output polar sample (stages) or pixel (last stage).
+:mod:`sarcli.focus.ffbp` [UlaHelSte2003], one thread per polar row (stage 0 and the merges, their scratch rows in
+device memory) or pixel (last stage).
 
 **One source, two targets.** The arithmetic of a sample lives once, in the ``@njit`` helpers of
-:mod:`sarcli.focus.ffbp` (``_stage0_sample``, ``_merge_sample``, ``_final_pixel`` and what they call). The CPU
+:mod:`sarcli.focus.ffbp` (``_stage0_row``, ``_merge_row``, ``_final_pixels`` and what they call). The CPU
 kernels call them from ``prange`` loops; here the same Python source of each helper (its ``py_func``) is
 compiled a second time as a CUDA device function (:func:`_twin`), its calls to the other helpers bound to their
 CUDA twins. The kernels below only map a thread to its sample, give it ``cuda.local.array`` scratch instead of
@@ -41,75 +42,79 @@ import types
 from typing import Any
 
 import numpy as np
-from numba import cuda, float64
+from numba import complex128, cuda, float64
 
 from sarcli.focus import ffbp as cpu
 from sarcli.gpu.device import Cuda
 
 EPS32 = float(np.finfo(np.float32).eps)
 EPS64 = float(np.finfo(np.float64).eps)
-THREADS = 128  # threads per block (one sample or pixel each)
+THREADS = 128  # threads per block (one sample, row or pixel each)
+SCRATCH_BYTES = 1 << 28  # device scratch of one merge batch
 MAX_ORDER = cpu.MAX_ORDER
 
-# the @njit helpers of sarcli.focus.ffbp, callees before callers
-_HELPERS = ("_weights", "_cis", "_polar_point", "_band_u", "_cum", "_table", "_window_mean", "_inside", "_interp",
-            "_stage0_sample", "_merge_sample", "_final_pixel")
-_GLOBALS: dict[str, Any] = dict(vars(cpu))
+# the @njit helpers of sarcli.focus.ffbp (cis: of sarcli.focus.phasor), callees before callers
+_HELPERS = ("_weights", "cis", "_polar_point", "_row_points", "_phasors", "_band_u", "_cum", "_table", "_window_mean",
+            "_inside", "_interp", "_stage0_row", "_child_polar", "_ray_is_separable", "_column_along_ray",
+            "_merge_child_along_ray", "_merge_row", "_final_pixels")
+_TWINS: dict[str, Any] = {}
 
 
 def _twin(name: str) -> Any:
     """The CUDA device function compiled from the Python source of the @njit helper ``name`` of
-    :mod:`sarcli.focus.ffbp`, whose calls to other helpers resolve to their CUDA twins (``_GLOBALS``)."""
+    :mod:`sarcli.focus.ffbp` (in its own module's globals), whose calls to other helpers resolve to their CUDA
+    twins (``_TWINS``)."""
     py = getattr(cpu, name).py_func
-    fn = types.FunctionType(py.__code__, _GLOBALS, py.__name__, py.__defaults__, py.__closure__)
+    fn = types.FunctionType(py.__code__, {**py.__globals__, **_TWINS}, py.__name__, py.__defaults__, py.__closure__)
     dev = cuda.jit(device=True)(fn)
-    _GLOBALS[name] = dev
+    _TWINS[name] = dev
     return dev
 
 
 _D = {name: _twin(name) for name in _HELPERS}
-_stage0_sample = _D["_stage0_sample"]
-_merge_sample = _D["_merge_sample"]
-_final_pixel = _D["_final_pixel"]
+_stage0_row = _D["_stage0_row"]
+_merge_row = _D["_merge_row"]
+_final_pixels = _D["_final_pixels"]
 
 
 @cuda.jit
 def stage0_kernel(lines, r_first, dr_in, k, pos, ref, w, sub_start, sub_stop, frames, p0, nrm, g_r0, g_u0, g_du,
-                  g_nr, g_off, dr, row_sub, row_iu, width, out):
-    """:func:`sarcli.focus.ffbp.stage0_kernel`: thread t is sample ir = t mod width of row q = t div width."""
+                  g_nr, g_off, dr, row_sub, row_iu, q0, n_q, pts, r, rcs, cr, ci, acc, out):
+    """:func:`sarcli.focus.ffbp.stage0_kernel`, one thread per row q0 + t (t < n_q), its scratch row t of the
+    global arrays ``pts`` .. ``acc``."""
     t = cuda.grid(1)
-    q = t // width
-    ir = t - q * width
-    if q >= row_sub.size:
+    if t >= n_q:
         return
+    q = q0 + t
     s = row_sub[q]
-    if ir >= g_nr[s]:
-        return
-    iu = row_iu[q]
-    out[g_off[s] + iu * g_nr[s] + ir] = _stage0_sample(lines, r_first, dr_in, k, pos, ref, w, sub_start[s],
-                                                       sub_stop[s], frames[s], p0, nrm, g_r0[s] + ir * dr,
-                                                       g_u0[s] + iu * g_du[s])
+    n = g_nr[s]
+    _stage0_row(lines, r_first, dr_in, k, pos, ref, w, sub_start[s], sub_stop[s], frames[s], p0, nrm, g_r0[s],
+                g_u0[s] + row_iu[q] * g_du[s], n, dr, pts[t], r[t], rcs[t], cr[t], ci[t], acc[t])
+    base = g_off[s] + row_iu[q] * n
+    for i in range(n):
+        out[base + i] = acc[t, i]
 
 
 @cuda.jit
 def merge_kernel(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start, kid_stop, frames, p0, nrm, g_r0,
-                 g_u0, g_du, g_nr, g_off, dr, k, order, range_order, tab_u, tab_r, row_sub, row_iu, width, out):
-    """:func:`sarcli.focus.ffbp.merge_kernel`, one thread per parent polar sample (as :func:`stage0_kernel`)."""
+                 g_u0, g_du, g_nr, g_off, dr, k, order, range_order, tab_u, tab_r, row_sub, row_iu, gamma_max, q0, n_q,
+                 pts, r, rcs, ucs, cr, ci, col, acc, out):
+    """:func:`sarcli.focus.ffbp.merge_kernel`, one thread per parent row q0 + t (t < n_q), its scratch row t of
+    the global arrays ``pts`` .. ``acc``."""
     t = cuda.grid(1)
-    q = t // width
-    ir = t - q * width
-    if q >= row_sub.size:
+    if t >= n_q:
         return
+    q = q0 + t
     s = row_sub[q]
-    if ir >= g_nr[s]:
-        return
-    iu = row_iu[q]
+    n = g_nr[s]
     wr = cuda.local.array(MAX_ORDER, float64)
     wu = cuda.local.array(MAX_ORDER, float64)
-    out[g_off[s] + iu * g_nr[s] + ir] = _merge_sample(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off,
-                                                      kid_start[s], kid_stop[s], frames[s], p0, nrm,
-                                                      g_r0[s] + ir * dr, g_u0[s] + iu * g_du[s], dr, k, order,
-                                                      range_order, tab_u, tab_r, wr, wu)
+    _merge_row(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start[s], kid_stop[s], frames[s], p0, nrm,
+               g_r0[s], g_u0[s] + row_iu[q] * g_du[s], n, dr, k, order, range_order, tab_u, tab_r, gamma_max, wr, wu,
+               pts[t], r[t], rcs[t], ucs[t], cr[t], ci[t], col[t], acc[t])
+    base = g_off[s] + row_iu[q] * n
+    for i in range(n):
+        out[base + i] = acc[t, i]
 
 
 @cuda.jit
@@ -122,11 +127,16 @@ def final_kernel(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, su
         return
     wr = cuda.local.array(MAX_ORDER, float64)
     wu = cuda.local.array(MAX_ORDER, float64)
-    acc, ws = _final_pixel(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, sub_stop, sub_w, pix[m, 0],
-                           pix[m, 1], pix[m, 2], r_out[m], dr, k, order, range_order, tab_u, tab_r, mode, bpar[m],
-                           pos, vel, par, wtab, ctab, span_max, lines, r_first, dr_in, ref, w, wr, wu)
-    out[m] = acc
-    wsum[m] = ws
+    rcs = cuda.local.array(1, float64)
+    frs = cuda.local.array(1, float64)
+    fus = cuda.local.array(1, float64)
+    cr = cuda.local.array(1, float64)
+    ci = cuda.local.array(1, float64)
+    acc = cuda.local.array(1, complex128)
+    wsa = cuda.local.array(1, float64)
+    _final_pixels(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, sub_stop, sub_w, pix, r_out, m, m + 1,
+                  dr, k, order, range_order, tab_u, tab_r, mode, bpar, pos, vel, par, wtab, ctab, span_max, lines,
+                  r_first, dr_in, ref, w, wr, wu, rcs, frs, fus, cr, ci, acc, wsa, out, wsum)
 
 
 def _blocks(n: int) -> int:
@@ -138,32 +148,57 @@ def _on(dev: Cuda, *arrays: Any) -> list[Any]:
     return [a if not isinstance(a, np.ndarray) else dev.asarray(np.ascontiguousarray(a)) for a in arrays]
 
 
+def _row_scratch(xp: Any, rows: int, width: int, c_width: int) -> tuple[Any, ...]:
+    """Device scratch of ``rows`` row threads (:func:`stage0_kernel`, :func:`merge_kernel`): pts, r, rcs, ucs,
+    cr, ci, col, acc, as :func:`sarcli.focus.ffbp.merge_kernel` allocates per row."""
+    return (xp.empty((rows, width, 3)), xp.empty((rows, width)), xp.empty((rows, width)), xp.empty((rows, width)),
+            xp.empty((rows, width)), xp.empty((rows, width)), xp.empty((rows, c_width), xp.complex128),
+            xp.empty((rows, width), xp.complex128))
+
+
+def _row_batch(n_rows: int, width: int, c_width: int) -> int:
+    """Rows per launch so that their scratch (:func:`_row_scratch`: 80 bytes per sample, 16 per child column)
+    stays within :data:`SCRATCH_BYTES`."""
+    return max(1, min(n_rows, SCRATCH_BYTES // (80 * width + 16 * c_width)))
+
+
 def stage0(dev: Cuda, lines, r_first, dr_in, k, pos, ref, w, sub_start, sub_stop, frames, p0, nrm, g_r0, g_u0, g_du,
            g_nr, g_off, dr, row_sub, row_iu, size: int) -> Any:
     """Stage 0 on ``dev`` (arguments of :func:`sarcli.focus.ffbp.stage0_kernel`): the (size,) complex64 polar
-    images, left on the device."""
+    images, left on the device; rows in batches (:func:`_row_batch`)."""
     out = dev.xp.zeros(size, dev.xp.complex64)
-    width = max(1, int(np.max(g_nr))) if g_nr.size else 1
-    n = row_sub.size * width
-    if n:
-        stage0_kernel[_blocks(n), THREADS](*_on(dev, lines), float(r_first), float(dr_in), float(k),
-                                           *_on(dev, pos, ref, w, sub_start, sub_stop, frames, p0, nrm, g_r0, g_u0,
-                                                g_du, g_nr, g_off), float(dr), *_on(dev, row_sub, row_iu), width, out)
+    if not row_sub.size:
+        return out
+    width = max(1, int(np.max(g_nr)))
+    batch = _row_batch(row_sub.size, width, 1)
+    pts, r, rcs, _, cr, ci, _, acc = _row_scratch(dev.xp, batch, width, 1)
+    args = (*_on(dev, lines), float(r_first), float(dr_in), float(k),
+            *_on(dev, pos, ref, w, sub_start, sub_stop, frames, p0, nrm, g_r0, g_u0, g_du, g_nr, g_off), float(dr),
+            *_on(dev, row_sub, row_iu))
+    for q0 in range(0, row_sub.size, batch):
+        n_q = min(batch, row_sub.size - q0)
+        stage0_kernel[_blocks(n_q), THREADS](*args, q0, n_q, pts, r, rcs, cr, ci, acc, out)
     return out
 
 
 def merge(dev: Cuda, child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start, kid_stop, frames, p0, nrm,
-          g_r0, g_u0, g_du, g_nr, g_off, dr, k, order, range_order, tab_u, tab_r, row_sub, row_iu, size: int) -> Any:
+          g_r0, g_u0, g_du, g_nr, g_off, dr, k, order, range_order, tab_u, tab_r, row_sub, row_iu, gamma_max,
+          size: int) -> Any:
     """One merge stage on ``dev`` (arguments of :func:`sarcli.focus.ffbp.merge_kernel`; ``child`` on the
-    device): the (size,) complex64 parent images, left on the device."""
+    device): the (size,) complex64 parent images, left on the device; rows in batches (:func:`_row_batch`)."""
     out = dev.xp.zeros(size, dev.xp.complex64)
-    width = max(1, int(np.max(g_nr))) if g_nr.size else 1
-    n = row_sub.size * width
-    if n:
-        merge_kernel[_blocks(n), THREADS](child, *_on(dev, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start,
-                                                      kid_stop, frames, p0, nrm, g_r0, g_u0, g_du, g_nr, g_off),
-                                          float(dr), float(k), int(order), int(range_order),
-                                          *_on(dev, tab_u, tab_r, row_sub, row_iu), width, out)
+    if not row_sub.size:
+        return out
+    width = max(1, int(np.max(g_nr)))
+    c_width = max(1, int(np.max(c_nr))) if c_nr.size else 1
+    batch = _row_batch(row_sub.size, width, c_width)
+    scratch = _row_scratch(dev.xp, batch, width, c_width)
+    args = (child, *_on(dev, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, kid_start, kid_stop, frames, p0, nrm,
+                        g_r0, g_u0, g_du, g_nr, g_off), float(dr), float(k), int(order), int(range_order),
+            *_on(dev, tab_u, tab_r, row_sub, row_iu), float(gamma_max))
+    for q0 in range(0, row_sub.size, batch):
+        n_q = min(batch, row_sub.size - q0)
+        merge_kernel[_blocks(n_q), THREADS](*args, q0, n_q, *scratch, out)
     return out
 
 
@@ -188,10 +223,7 @@ def lebesgue(order: int, oversample: float) -> float:
     """Lebesgue constant of the interpolation kernel of ``order`` taps (:func:`sarcli.focus.ffbp.kernel_table`):
     max over the offset mu in [0, 1) of sum_i |h(mu - node_i)|, on the table's own 1/TABLE_Q steps (the
     lookup interpolates the table linearly, so its sums are convex combinations of these)."""
-    tab = np.abs(cpu.kernel_table(order, oversample))
-    q = cpu.TABLE_Q
-    idx = np.arange(q + 1)[:, None] + q * np.arange(order)[None, :]
-    return float(np.max(tab[np.minimum(idx, tab.size - 1)].sum(axis=1)))
+    return float(np.max(np.abs(cpu.kernel_table(order, oversample)).sum(axis=1)))
 
 
 def ffbp_bound(knobs: cpu.FfbpKnobs, stages: int, range_oversample: float, lines: np.ndarray, weights: np.ndarray,

@@ -21,10 +21,13 @@ from scipy.optimize import brentq
 
 from sarcli.errors import ConfigError
 from sarcli.focus.ffbp import (
+    ALONG_RAY_SLACK,
+    MAX_ORDER,
     TABLE_Q,
     FfbpKnobs,
     _frames,
     _interp,
+    _merge_row,
     _polar_point,
     _weights,
     ffbp,
@@ -138,6 +141,77 @@ def test_stage0_matches_numpy():
                     v = np.interp(rho, grid, lines[n].real) + 1j * np.interp(rho, grid, lines[n].imag)
                     acc += w[n] * v * np.exp(1j * k * (rho - r))
                 assert abs(out[off[s] + iu * nr[s] + ir] - acc) < 1e-5 * 4
+
+
+def _row_coordinates(fr, p0, nrm, c_frames, r0, u, n, dr):
+    """(rc, uc) (4, n): each child's polar coordinates of the parent row's samples (plain numpy)."""
+    rc, uc = np.empty((4, n)), np.empty((4, n))
+    for i in range(n):
+        y = np.array(_polar_point(fr, p0, nrm, r0 + i * dr, u))
+        for c in range(4):
+            d = y - c_frames[c, 0]
+            rc[c, i] = np.linalg.norm(d)
+            uc[c, i] = c_frames[c, 1] @ d / rc[c, i]
+    return rc, uc
+
+
+@pytest.mark.parametrize("height, ground", [(1000.0, 3000.0), (2.0, 9.0)])
+def test_merge_row_along_ray_and_in_2d_match_numpy(height, ground):
+    """A merged parent row (4 children of 16 pulses 0.5 m apart on a straight track at ``height`` over a
+    scene ``ground`` m away) against plain numpy: each child's polar image a sum of 5 plane waves in its own
+    samples within its band (|nu_r| <= 1/(2U), |nu_u| <= 1/(2 beta), U = beta = 2), the exact sum of the
+    children at the row's samples re-referenced; within the kernels' bound e_6(beta) + e_6(U / (1 + slack))
+    of the waves' total amplitude, by the along-ray merge and by the 2-D one. Far from the track (3.2 km) the
+    rows are separable; 9 m from it they are not, and the merge falls back to 2-D there."""
+    rng = np.random.default_rng(5)
+    pos = _track(64, 0.0)
+    pos[:, 2] = height
+    p0, nrm = np.array([ground, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    c_frames, c_len = _frames(pos, np.arange(0, 64, 16), np.arange(16, 65, 16), p0)
+    fr = _frames(pos, np.array([0]), np.array([64]), p0)[0][0]
+    k, dr, u, n = 4 * np.pi / 0.03, 0.1, 0.003, 40
+    c_du = 0.03 / (2 * 2.0 * c_len)
+    r0 = np.floor((np.hypot(height, ground) - 2.0) / dr) * dr
+    rc, uc = _row_coordinates(fr, p0, nrm, c_frames, r0, u, n, dr)
+    # child grids on the range lattice, 10 samples beyond the row's coordinates each way
+    c_r0 = np.floor(rc.min(axis=1) / dr - 10) * dr
+    c_nr = np.ceil((rc.max(axis=1) - c_r0) / dr + 10).astype(np.int64)
+    c_u0 = uc.min(axis=1) - 10 * c_du
+    c_nu = np.ceil((uc.max(axis=1) - c_u0) / c_du + 10).astype(np.int64)
+    c_off = np.r_[0, np.cumsum(c_nr * c_nu)[:-1]].astype(np.int64)
+    waves = [(rng.uniform(-0.25, 0.25, 5), rng.uniform(-0.25, 0.25, 5), rng.normal(size=5) + 1j * rng.normal(size=5))
+             for _ in range(4)]
+
+    def child_image(c, r, v):  # r, v: arrays of child ranges and angles
+        nu_r, nu_u, a = waves[c]
+        ph = nu_r * ((r - c_r0[c]) / dr)[..., None] + nu_u * ((v - c_u0[c]) / c_du[c])[..., None]
+        return np.sum(a * np.exp(2j * np.pi * ph), axis=-1)
+
+    child = np.concatenate([child_image(c, *np.meshgrid(c_r0[c] + dr * np.arange(c_nr[c]),
+                                                        c_u0[c] + c_du[c] * np.arange(c_nu[c]))).ravel()
+                            for c in range(4)]).astype(np.complex64)
+    ref = sum(child_image(c, rc[c], uc[c]) * np.exp(1j * k * (rc[c] - (r0 + dr * np.arange(n)))) for c in range(4))
+    amp = sum(np.abs(w[2]).sum() for w in waves)
+    bound = amp * (kernel_error(6, 2.0) + kernel_error(6, 2.0 / (1 + ALONG_RAY_SLACK)))
+    results = {}
+    for name, gamma_max in (("along ray", 1e9), ("2-D", 0.0), ("as chosen", ALONG_RAY_SLACK)):
+        acc = np.zeros(n, complex)
+        width = int(c_nr.max())
+        _merge_row(child, c_frames, c_r0, c_u0, c_du, c_nr, c_nu, c_off, 0, 4, fr, p0, nrm, r0, u, n, dr, k, 6, 6,
+                   kernel_table(6, 2.0), kernel_table(6, 2.0), gamma_max, np.empty(MAX_ORDER), np.empty(MAX_ORDER),
+                   np.empty((n, 3)), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
+                   np.empty(width, complex), acc)
+        results[name] = acc
+    # gamma: angle samples per range sample along the row, the largest over the children
+    gamma = max(np.abs(np.diff(uc[c])).max() / c_du[c] * dr / np.diff(rc[c]).min() for c in range(4))
+    assert np.abs(results["2-D"] - ref).max() <= bound
+    if gamma <= ALONG_RAY_SLACK:
+        assert height > 100  # far from the track: separable, so the merge as chosen is the along-ray one
+        assert np.abs(results["along ray"] - ref).max() <= bound
+        np.testing.assert_array_equal(results["as chosen"], results["along ray"])
+    else:
+        assert height < 10  # near the track the drift is too large for the range kernel: the merge stays 2-D
+        np.testing.assert_array_equal(results["as chosen"], results["2-D"])
 
 
 # --- end to end: a point target from a straight track, plain numpy echo and backprojection ---
