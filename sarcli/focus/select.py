@@ -106,10 +106,15 @@ COST_OMEGAK_MONO = 1.58 * COST_RD
 COST_OMEGAK_FULL = 5.4 * COST_RD
 #: backprojection: seconds per (pixel x aperture line) over seconds per (sample x log2 samples) of two fft2
 COST_BP = 35.0  # bench_focus_family: the exact kernel over its aperture, extrapolated to the block (35-57 in 3 runs)
-#: ffbp: one interpolation tap of a merge against one exact backprojection term, from the ffbp focuser
-#: on the map's airborne X band scene (1440 x 244, 1140 aperture lines, default knobs: 19.9 s, against
-#: the exact kernel's 180 s extrapolated with COST_BP = 50; same machine, same load), to be re-measured
-COST_FFBP_TAP = 0.036 * 50.0 / COST_BP
+#: ffbp: one interpolation tap of a merge against one exact backprojection term (the float32 kernel),
+#: from GOTCHA pass 1 HH in bench_gotcha (27 Nov 21:51, same run, best of 5): ffbp with the default knobs
+#: 0.476 s against the float32 backprojection's 0.609 s over 469 pulses, i.e. 367 backprojection terms
+#: per pixel for the model's (S + 1) base beta U taps = 5 x 4 x 2 x 2 x 36 = 2880 taps; on bench_ffbp's
+#: stripmap scene (710 aperture lines) the model then predicts 1.9x and 2.3x was measured. The product of
+#: the taps stands for the last stage's 2-D interpolation; the merges cost about order + range_order plus a
+#: fixed part (the along-ray merge), so the model ranks coarser kernels too costly (4 x 4 taps: 0.85x the
+#: defaults' time, predicted 0.44x): re-measured by the map
+COST_FFBP_TAP = 367.0 / 2880.0
 #: the 2 fft2 time per (sample x log2 samples) on the bench machine (s): predicted seconds for the report
 SECONDS_2FFT2 = 4.0e-9  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)
 #: on an ORBIT, the largest |squint| (deg) at which the map validated the hyperbolic-model focusers: beyond
