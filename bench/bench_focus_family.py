@@ -18,7 +18,7 @@ model's prediction (:func:`sarcli.focus.select.predict`) and both verdicts again
 quality. Calibration for ``sarcli.focus.select`` (printed, not written into it): the median RD
 ratio, the backprojection cost constant and the two-fft2 seconds per (sample x log2 samples).
 
-Run: ``python -m bench.run_all bench_focus_family`` (9.5 minutes on 2 loaded cores with all five focusers).
+Run: ``python -m bench.run_all bench_focus_family`` (9 minutes on 2 quiet cores with all five focusers, 24 scenes).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from bench.family import (
     window_irw,
 )
 
-MAX_SAMPLES = 5_000_000
+MAX_SAMPLES = 60_000_000
 #: the scenes on which every knob setting of KNOB_SETTINGS runs; elsewhere each focuser runs with its own
 #: defaults (the knob sweep on every scene would take the bench past half an hour once csa, omegak and
 #: ffbp are registered)

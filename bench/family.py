@@ -18,7 +18,10 @@ through (fdc, fr) at the mid target's beam centre (:class:`sarcli.model.doppler.
 
 The raw range window holds every target's closest range (the focusers' output columns are the raw
 range grid) and its echo at the beam centre, R0 / cos(theta) and the range walk: the window grows as
-R0 (1 / cos(theta) - 1), which is what limits the squint a small scene can have.
+R0 (1 / cos(theta) - 1), which is what limits the squint a small scene can have. The lines hold every
+target's exposure and reach its output row: the focusers' output lines are the raw lines shifted by one
+beam-centre offset, the one at the window's middle range, which exceeds a target's own by
+(r_mid - R0) tan(theta) / V (1200 lines for the airborne X band scene at 30 deg).
 
 Measurement (:func:`measure`): the exact reference is backprojection of the same lines onto a
 ``CHIP`` x ``CHIP`` window around each target (:func:`exact_chip`, the backprojection focuser's kernel
@@ -126,7 +129,7 @@ def make_scene(case: Case) -> Scene:
     # zero-Doppler geometry of the mid target, on a generous orbit record (the beam offset R0 tan / V)
     v_guess = 7100.0 if case.track == "orbit" else p["velocity"]
     t_ap_guess = p["ba"] * lam * r0 / (2 * v_guess**2 * math.cos(theta) ** 3)
-    span = r0 * math.tan(theta) / v_guess + t_ap_guess + 10.0
+    span = r0 * math.tan(theta) / (v_guess * math.cos(theta)) + t_ap_guess + 10.0  # to the window's far range
     orbit = _orbit(case, -span - 5.0, span + 5.0)
     side = "right"
 
@@ -155,25 +158,36 @@ def make_scene(case: Case) -> Scene:
     targets = [(float(dt), float(r0 + drg)) for drg, dt in case.offsets]
     xs = [target(t, r) for t, r in targets]
     prf = p["prf"]
+    pulse = p["pulse"]
     # lines: every target's exposure, plus a margin of half a chip
     t_first = min(t for t, _ in targets) + eta_c - 0.5 * t_ap - CHIP / prf
     t_last = max(t for t, _ in targets) + eta_c + 0.5 * t_ap + CHIP / prf
-    n_lines = int(math.ceil((t_last - t_first) * prf))
-    eta = t_first + np.arange(n_lines) / prf
-    pos, vel = platform_state(orbit, EPOCH, eta)
-    hist = []
-    for x in xs:
-        r, fd = _doppler(x, pos, vel, lam)
-        on = np.abs(fd - fdc) <= 0.5 * EXPOSURE * p["ba"]
-        hist.append((r, on))
-    pulse = p["pulse"]
-    # the chirp of a target at R spans R +- c T / 4 in range samples: whole in the window
-    r_lo = min(min(r for _, r in targets) - CHIP * dr, min(float(np.min(r[on])) for r, on in hist) - 0.25 * C * pulse)
-    r_lo -= 16 * dr
-    r_hi = max(float(np.max(r[on])) for r, on in hist) + 0.25 * C * pulse + 16 * dr
-    n_samples = int(math.ceil((r_hi - r_lo) / dr))
+    for _ in range(4):
+        n_lines = int(math.ceil((t_last - t_first) * prf))
+        eta = t_first + np.arange(n_lines) / prf
+        pos, vel = platform_state(orbit, EPOCH, eta)
+        hist = []
+        for x in xs:
+            r, fd = _doppler(x, pos, vel, lam)
+            on = np.abs(fd - fdc) <= 0.5 * EXPOSURE * p["ba"]
+            hist.append((r, on))
+        # the chirp of a target at R spans R +- c T / 4 in range samples: whole in the window
+        r_lo = min(min(r for _, r in targets) - CHIP * dr,
+                   min(float(np.min(r[on])) for r, on in hist) - 0.25 * C * pulse) - 16 * dr
+        r_hi = max(float(np.max(r[on])) for r, on in hist) + 0.25 * C * pulse + 16 * dr
+        n_samples = int(math.ceil((r_hi - r_lo) / dr))
+        # the focusers' output line j is at zero-Doppler time t_raw[j] - shift / PRF with one shift, the
+        # beam-centre offset at the window's middle range; at large squint the window spans R0 .. R0 / cos
+        # and that offset exceeds the targets' own by (r_mid - R0) tan(theta) / V: the lines must reach
+        # every target's output row (and half a chip beyond it)
+        t_need = _lines_needed(eta, n_samples, prf, dop, orbit, _radar(f0, lam, prf, fs, band, pulse, r_lo, vel),
+                               targets)
+        if t_need is None:
+            break
+        t_first, t_last = min(t_first, t_need[0]), max(t_last, t_need[1])
     rng = r_lo + np.arange(n_samples) * dr
-    k = band / pulse
+    radar = _radar(f0, lam, prf, fs, band, pulse, r_lo, vel)
+    k = radar.chirp_rate_hz_per_s
     echo = np.zeros((n_lines, n_samples), np.complex64)
     half = int(math.ceil(0.5 * C * pulse / dr)) + 1
     for r, on in hist:
@@ -183,14 +197,38 @@ def make_scene(case: Case) -> Scene:
             d = 2.0 * (rng[a:b] - r[n]) / C
             inside = np.abs(d) <= 0.5 * pulse
             echo[n, a:b] += np.where(inside, np.exp(1j * np.pi * k * d * d - 4j * np.pi * r[n] / lam), 0)
-    radar = Radar(carrier_frequency_hz=f0, wavelength_m=lam, prf_hz=prf, range_sampling_rate_hz=fs,
-                  chirp_rate_hz_per_s=k, pulse_length_s=pulse, window_start_s=2 * r_lo / C, first_range_m=r_lo,
-                  platform_velocity_mps=float(np.linalg.norm(vel[0])))
     raw = RawProduct(echo=echo, azimuth_time=eta, epoch_utc=EPOCH, radar=radar, orbit=orbit, look_side=side,
                      source="simulated")
     return Scene(raw=raw, doppler=dop, targets=targets, fdc=fdc, aperture_lines=t_ap / EXPOSURE * prf,
                  info={"v_eff": v_eff, "fdc_hz": fdc, "fr_hz_per_s": fr_c, "beam_offset_s": eta_c,
                        "shape": [n_lines, n_samples], "pixels": n_lines * n_samples})
+
+
+def _radar(f0: float, lam: float, prf: float, fs: float, band: float, pulse: float, r_lo: float,
+               vel: np.ndarray) -> Radar:
+    """The scene's radar: chirp of ``band`` over ``pulse``, window from ``r_lo``."""
+    return Radar(carrier_frequency_hz=f0, wavelength_m=lam, prf_hz=prf, range_sampling_rate_hz=fs,
+                 chirp_rate_hz_per_s=band / pulse, pulse_length_s=pulse, window_start_s=2 * r_lo / C,
+                 first_range_m=r_lo, platform_velocity_mps=float(np.linalg.norm(vel[0])))
+
+
+def _lines_needed(eta: np.ndarray, n_samples: int, prf: float, dop, orbit: Orbit, radar: Radar,
+                  targets) -> tuple[float, float] | None:
+    """None where every target's output row (:func:`sarcli.focus.rda.plan_grid` on these lines and range
+    window) lies half a chip and 16 lines inside the lines; else the raw times (first, last) that would hold
+    them."""
+    from sarcli.focus.rda import plan_grid
+
+    probe = RawProduct(echo=np.zeros((eta.size, 1), np.complex64), azimuth_time=eta, epoch_utc=EPOCH, radar=radar,
+                       orbit=orbit, look_side="right", source="simulated")
+    grid = plan_grid(probe, (eta.size, n_samples), dop, None)
+    t_zd = grid.zero_doppler_times(eta)
+    margin = (CHIP // 2 + 16) / prf
+    lo = min(t for t, _ in targets) - margin
+    hi = max(t for t, _ in targets) + margin
+    if t_zd[0] <= lo and t_zd[-1] >= hi:
+        return None
+    return eta[0] + min(0.0, lo - t_zd[0]), eta[-1] + max(0.0, hi - t_zd[-1])
 
 
 def scene_size(case: Case) -> int:
@@ -203,9 +241,11 @@ def scene_size(case: Case) -> int:
     th = math.radians(case.squint_deg)
     v = 7100.0 if case.track == "orbit" else p["velocity"]
     t_ap = EXPOSURE * p["ba"] * lam * p["r0"] / (2 * v**2 * math.cos(th) ** 3)
-    lines = t_ap * p["prf"] + 2 * CHIP
     walk = v * math.sin(th) * t_ap
     samples = (p["r0"] * (1 / math.cos(th) - 1) + walk + 0.5 * C * p["pulse"]) / dr + 32
+    # the exposure, and the lines that reach the targets' output rows (:func:`_lines_needed`): the output's
+    # one shift is the beam offset at the window's middle range, half the window beyond R0
+    lines = (t_ap + 0.5 * samples * dr * math.tan(th) / v) * p["prf"] + 2 * CHIP
     return int(lines * samples)
 
 

@@ -84,6 +84,26 @@ def test_relative_bandwidth_raises_rd_error():
 
 # --------------------------------------------------------------------------- model against the measured map
 
+def test_squinted_map_scene_holds_its_target_where_the_focusers_put_it():
+    """At 30 deg the focusers' output lines (the raw lines shifted by the beam offset at the window's middle
+    range, rda.plan_grid) lie 1200 lines later than the target's exposure on the map's airborne X band
+    scene: the scene must reach that row. Checked independently of the scene's own arithmetic: the exact
+    backprojection of its lines onto the 64 x 64 chip about that row peaks at the target, within the
+    reference's 0.1-pixel interpolation error (a 150 MHz band keeps the scene small)."""
+    from bench.family import CHIP, Case, exact_chip, make_scene, pixel_of
+    from sarcli.focus.quality import point_target_metrics
+    from sarcli.focus.rda import plan_grid
+
+    sc = make_scene(Case("X", "airborne", 30.0, range_bandwidth_hz=150e6))
+    grid = plan_grid(sc.raw, sc.raw.echo.shape, sc.doppler, None)
+    row, col = pixel_of(grid.zero_doppler_times(sc.raw.azimuth_time), grid.ranges, sc.targets[0])
+    r0, c0 = int(round(row)) - CHIP // 2, int(round(col)) - CHIP // 2
+    assert r0 >= 0 and r0 + CHIP <= sc.raw.echo.shape[0]
+    chip, _ = exact_chip(sc, r0, c0)
+    m = point_target_metrics(chip, row - r0, col - c0, half=CHIP // 2, azimuth_carrier=sc.fdc / sc.raw.radar.prf_hz)
+    assert abs(m["row"] - (row - r0)) < 0.1 and abs(m["col"] - (col - c0)) < 0.1
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("case", [("C", "spaceborne", 0.0), ("C", "spaceborne", 5.0), ("X", "airborne", 10.0)])
 def test_model_against_measurement(case):
