@@ -25,7 +25,7 @@ import scipy.fft as sfft
 from numba import njit, prange
 
 from sarcli.errors import ConfigError
-from sarcli.focus.phasor import ANCHOR_EVERY, EPS_MAX, cis, cis_step
+from sarcli.focus.phasor import ANCHOR_EVERY, EPS_MAX, advance_phasor, anchor_phasor
 from sarcli.focus.windows import table_lookup, window, window_table
 from sarcli.threads import fft_workers
 
@@ -155,15 +155,8 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
                     r = np.sqrt(dx * dx + dy * dy + dz * dz)
                     rr[c] = r
                     rh = r - qr[c]
-                    dl = rh - (np.sqrt(ex * ex + ey * ey + ez * ez) - qr[c])
-                    c1, s1 = cis(k4 * rh)
-                    c2, s2 = cis(k4 * dl)
-                    pre[c] = np.float32(c1)
-                    pim[c] = np.float32(s1)
-                    dre[c] = np.float32(c2)
-                    dim[c] = np.float32(s2)
-                    rho[c] = rh
-                    dlt[c] = dl
+                    anchor_phasor(k4, rh, rh - (np.sqrt(ex * ex + ey * ey + ez * ez) - qr[c]), c, pre, pim, dre,
+                                  dim, rho, dlt)
             else:  # D <- D exp(j eps), P <- P D
                 for c in range(nm):
                     dx = qx[c] - p0
@@ -171,21 +164,7 @@ def backproject32(pairs, r_first, dr, wavelength, pos, vel, pix, r_ref, fdc, ba,
                     dz = qz[c] - p2
                     r = np.sqrt(dx * dx + dy * dy + dz * dz)
                     rr[c] = r
-                    rh = r - qr[c]
-                    dl = rh - rho[c]
-                    ec, es = cis_step(np.float32(k4 * (dl - dlt[c])))
-                    a = dre[c]
-                    b = dim[c]
-                    a2 = a * ec - b * es
-                    b2 = a * es + b * ec
-                    pp = pre[c]
-                    ss = pim[c]
-                    pre[c] = pp * a2 - ss * b2
-                    pim[c] = pp * b2 + ss * a2
-                    dre[c] = a2
-                    dim[c] = b2
-                    rho[c] = rh
-                    dlt[c] = dl
+                    advance_phasor(k4, r - qr[c], c, pre, pim, dre, dim, rho, dlt)
             seen = 0
             v0 = vel[n, 0]
             v1 = vel[n, 1]

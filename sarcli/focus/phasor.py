@@ -94,6 +94,41 @@ def cis_step(e):
     return _F1 + e2 * (_C2 + e2 * _C4), e * (_F1 + e2 * (_S3 + e2 * _S5))
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def anchor_phasor(k, rh, dl, c, pre, pim, dre, dim, rho, dlt):
+    """Anchor the recurrence of sample ``c`` at range ``rh`` with last step ``dl`` (m): P = exp(j k rh) and
+    D = exp(j k dl) from :func:`cis`, rounded to float32 into ``pre``/``pim`` and ``dre``/``dim``; the
+    float64 ``rh`` and ``dl`` kept in ``rho`` and ``dlt`` (the kernels' per-sample state)."""
+    c1, s1 = cis(k * rh)
+    c2, s2 = cis(k * dl)
+    pre[c] = np.float32(c1)
+    pim[c] = np.float32(s1)
+    dre[c] = np.float32(c2)
+    dim[c] = np.float32(s2)
+    rho[c] = rh
+    dlt[c] = dl
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def advance_phasor(k, rh, c, pre, pim, dre, dim, rho, dlt):
+    """Advance sample ``c``'s recurrence to range ``rh`` (m): delta = rh - rho, eps = k (delta - the last
+    delta), D <- D exp(j eps) (:func:`cis_step`), P <- P D, in float32 (module docstring)."""
+    dl = rh - rho[c]
+    ec, es = cis_step(np.float32(k * (dl - dlt[c])))
+    a = dre[c]
+    b = dim[c]
+    a2 = a * ec - b * es
+    b2 = a * es + b * ec
+    p = pre[c]
+    q = pim[c]
+    pre[c] = p * a2 - q * b2
+    pim[c] = p * b2 + q * a2
+    dre[c] = a2
+    dim[c] = b2
+    rho[c] = rh
+    dlt[c] = dl
+
+
 def recurrence_bound(m: int | np.ndarray) -> float | np.ndarray:
     """Bound on ``|P~_m - exp(j k rho_m)|`` m samples after an anchor (module docstring), float32 phasors."""
     eta_a = U32 + CIS_ERROR

@@ -29,7 +29,7 @@ from numba import njit, prange
 
 from sarcli.errors import ConfigError
 from sarcli.focus.backprojection import FLOAT32_FLAGS, lerp_pairs
-from sarcli.focus.phasor import anchor_interval, cis, cis_step
+from sarcli.focus.phasor import advance_phasor, anchor_interval, anchor_phasor, cis
 from sarcli.gbsar.rangecomp import RangeProfiles
 from sarcli.gbsar.windows import taper, taper_at, taper_table
 
@@ -264,32 +264,10 @@ def bp_grid_kernel32(pairs, r_first, dr, ant, ref, w, xs, ys, z, kc, every, ty, 
                     yp2 = yp * yp
                     for c in range(ncl):
                         rh = np.sqrt(dx2[c] + yy2) - rf
-                        dl = rh - (np.sqrt(dx2[c] + yp2) - rf)
-                        c1, s1 = cis(kc * rh)
-                        c2, s2 = cis(kc * dl)
-                        pre[c] = np.float32(c1)
-                        pim[c] = np.float32(s1)
-                        dre[c] = np.float32(c2)
-                        dim[c] = np.float32(s2)
-                        rho[c] = rh
-                        dlt[c] = dl
+                        anchor_phasor(kc, rh, rh - (np.sqrt(dx2[c] + yp2) - rf), c, pre, pim, dre, dim, rho, dlt)
                 else:  # D <- D exp(j eps), P <- P D
                     for c in range(ncl):
-                        rh = np.sqrt(dx2[c] + yy2) - rf
-                        dl = rh - rho[c]
-                        ec, es = cis_step(np.float32(kc * (dl - dlt[c])))
-                        a = dre[c]
-                        b = dim[c]
-                        a2 = a * ec - b * es
-                        b2 = a * es + b * ec
-                        p = pre[c]
-                        s = pim[c]
-                        pre[c] = p * a2 - s * b2
-                        pim[c] = p * b2 + s * a2
-                        dre[c] = a2
-                        dim[c] = b2
-                        rho[c] = rh
-                        dlt[c] = dl
+                        advance_phasor(kc, np.sqrt(dx2[c] + yy2) - rf, c, pre, pim, dre, dim, rho, dlt)
                 if wd == 0.0:
                     continue
                 aw = acc_w[r]
