@@ -111,12 +111,12 @@ from sarcli.focus.rda import (
     _fft_inplace,
     _n_threads,
     _pooled,
+    check_block_knobs,
     model_grid,
     plan_grid,
     smooth_len,
 )
-from sarcli.focus.windows import parse_window, table_lookup, window_table
-from sarcli.gpu.device import check_device
+from sarcli.focus.windows import table_lookup, window_table
 from sarcli.model.raw import RawProduct
 from sarcli.model.slc import SLC, DopplerUsed
 from sarcli.model.terrain import ConstantHeight, Terrain
@@ -156,21 +156,10 @@ class CsaOptions:
     device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "device", check_device(self.device))
-        parse_window(self.range_window)
-        parse_window(self.azimuth_window)
+        check_block_knobs(self)
         parse_interpolator(self.interpolator)
-        if self.precision not in ("single", "double"):
-            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
         if self.range_oversample not in (1, 2):
             raise ConfigError(f"range_oversample must be 1 or 2, got {self.range_oversample}")
-        if self.block_lines < 64:
-            raise ConfigError(f"block_lines must be at least 64, got {self.block_lines}")
-        if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
-            raise ConfigError(f"range_bandwidth_fraction must be in (0, 1], got {self.range_bandwidth_fraction}")
-        if self.azimuth_bandwidth_hz is not None and not (math.isfinite(self.azimuth_bandwidth_hz)
-                                                          and self.azimuth_bandwidth_hz > 0):
-            raise ConfigError(f"azimuth_bandwidth_hz must be a positive number of Hz, got {self.azimuth_bandwidth_hz}")
         if self.reference_range_m is not None and not (math.isfinite(self.reference_range_m)
                                                        and self.reference_range_m > 0):
             raise ConfigError(f"reference_range_m must be a positive number of metres, got {self.reference_range_m}")

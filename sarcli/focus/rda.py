@@ -144,21 +144,28 @@ class RdOptions:
     device: Literal["cpu", "cuda"] = "cpu"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "device", check_device(self.device))
-        parse_window(self.range_window)
-        parse_window(self.azimuth_window)
+        check_block_knobs(self)
         parse_interpolator(self.rcmc)
-        if self.precision not in ("single", "double"):
-            raise ConfigError(f"precision must be 'single' or 'double', got {self.precision!r}")
         if self.rcmc_oversample not in (1, 2):
             raise ConfigError(f"rcmc_oversample must be 1 or 2, got {self.rcmc_oversample}")
-        if self.block_lines < 64:
-            raise ConfigError(f"block_lines must be at least 64, got {self.block_lines}")
-        if not (math.isfinite(self.range_bandwidth_fraction) and 0 < self.range_bandwidth_fraction <= 1):
-            raise ConfigError(f"range_bandwidth_fraction must be in (0, 1], got {self.range_bandwidth_fraction}")
-        if self.azimuth_bandwidth_hz is not None and not (math.isfinite(self.azimuth_bandwidth_hz)
-                                                          and self.azimuth_bandwidth_hz > 0):
-            raise ConfigError(f"azimuth_bandwidth_hz must be a positive number of Hz, got {self.azimuth_bandwidth_hz}")
+
+
+def check_block_knobs(opts) -> None:
+    """Check (and normalize ``device`` of) the knobs the frequency-domain focusers' options share under the
+    same names (:class:`RdOptions`, :class:`sarcli.focus.csa.CsaOptions`): device, range_window,
+    azimuth_window, precision, block_lines, range_bandwidth_fraction, azimuth_bandwidth_hz."""
+    object.__setattr__(opts, "device", check_device(opts.device))
+    parse_window(opts.range_window)
+    parse_window(opts.azimuth_window)
+    if opts.precision not in ("single", "double"):
+        raise ConfigError(f"precision must be 'single' or 'double', got {opts.precision!r}")
+    if opts.block_lines < 64:
+        raise ConfigError(f"block_lines must be at least 64, got {opts.block_lines}")
+    if not (math.isfinite(opts.range_bandwidth_fraction) and 0 < opts.range_bandwidth_fraction <= 1):
+        raise ConfigError(f"range_bandwidth_fraction must be in (0, 1], got {opts.range_bandwidth_fraction}")
+    if opts.azimuth_bandwidth_hz is not None and not (math.isfinite(opts.azimuth_bandwidth_hz)
+                                                      and opts.azimuth_bandwidth_hz > 0):
+        raise ConfigError(f"azimuth_bandwidth_hz must be a positive number of Hz, got {opts.azimuth_bandwidth_hz}")
 
 
 def _uniform_prf(t: np.ndarray, radar_prf: float) -> float:
