@@ -95,7 +95,6 @@ import numpy as np
 import scipy.fft as sfft
 from numba import njit
 
-from sarcli.config import to_mapping
 from sarcli.errors import ConfigError, SarcliError
 from sarcli.focus.interp import parse_interpolator, table_for
 from sarcli.focus.rangecomp import C, chirp_band, inverse_src_rate, reference_pulse
@@ -118,7 +117,7 @@ from sarcli.focus.rda import (
 )
 from sarcli.focus.windows import table_lookup, window_table
 from sarcli.model.raw import RawProduct
-from sarcli.model.slc import SLC, DopplerUsed
+from sarcli.model.slc import SLC
 from sarcli.model.terrain import ConstantHeight, Terrain
 
 REPLICA_TOLERANCE_RAD = 0.1  # rms phase deviation of the replica from the nominal chirp that warns
@@ -591,26 +590,9 @@ class ChirpScaling(RangeDoppler):
         _add(tm, "azimuth_ifft_s", t0)
         return img
 
-    def finish(self, plan: CsaPlan) -> SLC:  # type: ignore[override]
-        g, raw, k = plan.grid, plan.raw, plan.options
-        n_lines, nr = plan.output_shape
-        first_full, last_full = g.full_lines(n_lines)
-        fdcs = np.array([q["fdc"] for q in plan.block])
-        frs = np.array([q["fr"] for q in plan.block])
-        vs = np.array([q["v"] for q in plan.block])
-        dts = np.array([q["dt"] for q in plan.block])
-        params = {"algorithm": self.name, **to_mapping(k, keep_none=True), "azimuth_bandwidth_hz": g.ba,
-                  "prf_hz": g.prf, "shift_lines": g.shift, "overlap_lines": g.pad, "azimuth_fft_length": plan.n_fft_az,
-                  "block_output_lines": plan.n_valid, "range_fft_length": plan.n_fft_r, "n_blocks": plan.n_blocks,
-                  "aperture_lines": g.aperture, "orbit_timing_correction_max_s": float(np.max(np.abs(dts))),
-                  "reference_range_used_m": plan.r_ref, "chirp_scaling_max": plan.scaling_max,
-                  "replica_deviation": plan.replica, "terrain": plan.terrain.describe(), "warnings": plan.warnings}
-        return SLC.from_raw(raw, image=np.zeros((0, 0), np.complex64),
-                            azimuth_time=g.zero_doppler_times(raw.azimuth_time), slant_range=g.ranges.copy(),
-                            doppler=DopplerUsed(plan.block_time.copy(), g.ranges.copy(), fdcs, frs, vs),
-                            algorithm=self.name, azimuth_spacing_m=float(np.median(vs[:, nr // 2])) / g.prf,
-                            first_full_line=first_full, last_full_line=last_full, parameters=params,
-                            timings=dict(plan.timings))
+    def own_parameters(self, plan: CsaPlan) -> dict[str, Any]:  # type: ignore[override]
+        return {"reference_range_used_m": plan.r_ref, "chirp_scaling_max": plan.scaling_max,
+                "replica_deviation": plan.replica}
 
 
 CSA = ChirpScaling()

@@ -795,6 +795,13 @@ class RangeDoppler:
         mu = (late + blk["dt"][None, :] - line["dt"]) * g.prf
         return lines_c, np.ascontiguousarray(phi, np.float64), np.ascontiguousarray(mu, np.float64)
 
+    def own_parameters(self, plan: RdPlan) -> dict[str, Any]:
+        """The product parameters of this focuser beyond the ones every frequency-domain focuser records
+        (:meth:`finish`)."""
+        k, raw = plan.options, plan.raw
+        return {"model_grid_lines": GRID_LINES, "model_grid_samples": GRID_SAMPLES,
+                "replica_used": bool(k.use_replica and raw.replica is not None and np.size(raw.replica) > 1)}
+
     def finish(self, plan: RdPlan) -> SLC:
         g, raw, k = plan.grid, plan.raw, plan.options
         n_lines, nr = plan.output_shape
@@ -807,9 +814,7 @@ class RangeDoppler:
                   "prf_hz": g.prf, "shift_lines": g.shift, "overlap_lines": g.pad, "azimuth_fft_length": plan.n_fft_az,
                   "block_output_lines": plan.n_valid, "range_fft_length": plan.n_fft_r, "n_blocks": plan.n_blocks,
                   "aperture_lines": g.aperture, "orbit_timing_correction_max_s": float(np.max(np.abs(dts))),
-                  "model_grid_lines": GRID_LINES, "model_grid_samples": GRID_SAMPLES,
-                  "replica_used": bool(k.use_replica and raw.replica is not None and np.size(raw.replica) > 1),
-                  "terrain": plan.terrain.describe(), "warnings": plan.warnings}
+                  **self.own_parameters(plan), "terrain": plan.terrain.describe(), "warnings": plan.warnings}
         return SLC.from_raw(raw, image=np.zeros((0, 0), np.complex64),
                             azimuth_time=g.zero_doppler_times(raw.azimuth_time), slant_range=g.ranges.copy(),
                             doppler=DopplerUsed(plan.block_time.copy(), g.ranges.copy(), fdcs, frs, vs),
