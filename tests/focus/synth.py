@@ -58,3 +58,24 @@ def beam_offset(r0, fdc, velocity=7000.0, wavelength=0.0566):
     """Beam-centre time minus zero-Doppler time (s)."""
     s = sin_squint(fdc, velocity, wavelength)
     return r0 * s / np.sqrt(1 - s * s) / velocity
+
+
+#: the spaceborne C band point scene of the focuser tests (test_point_targets.py's geometry)
+SPACE_PRF, SPACE_FS, SPACE_LAM, SPACE_V, SPACE_BA = 1500.0, 24e6, 0.0566, 7000.0, 1200.0
+SPACE_DR = C / (2 * SPACE_FS)
+SPACE_R0 = 850e3 + 384.3 * SPACE_DR
+
+
+def focus_spaceborne(focus, fdc, window, **kw):
+    """One target at SPACE_R0 (zero-Doppler time 0.34 s + 0.37 line) seen at centroid ``fdc``, focused by
+    ``focus`` (focus_rd, focus_csa, focus_omegak) with ``window`` in range and azimuth, 90 % of the chirp
+    band and SPACE_BA of Doppler band -> (raw, slc, the target's row, its column)."""
+    from sarcli.model.doppler import GeometricDoppler
+
+    eta0 = 0.34 + 0.37 / SPACE_PRF - beam_offset(SPACE_R0, fdc)
+    raw = scene([(SPACE_R0, eta0, 1.0)], fdc=fdc)
+    dop = GeometricDoppler(SPACE_V, sin_squint(fdc), SPACE_LAM)
+    slc = focus(raw, dop, range_window=window, azimuth_window=window, range_bandwidth_fraction=0.9,
+                azimuth_bandwidth_hz=SPACE_BA, **kw)
+    row = float(np.interp(eta0, slc.azimuth_time, np.arange(slc.azimuth_time.size)))
+    return raw, slc, row, (SPACE_R0 - slc.slant_range[0]) / SPACE_DR

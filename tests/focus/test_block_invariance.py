@@ -227,14 +227,17 @@ def test_block_size_on_the_simulated_orbit_scene():
         assert np.max(np.abs(m[:, 3])) < 0.01, (bl, m[:, 3])
 
 
-def test_blocks_are_pure_functions_of_the_plan():
-    """Blocks run in any order (as a Dask graph would) give the serial image bit for bit."""
+@pytest.mark.parametrize("name", ["rd", "csa"])
+def test_blocks_are_pure_functions_of_the_plan(name):
+    """Blocks run in any order (as a Dask graph would) give the serial image bit for bit (rd, csa; omegak:
+    tests/focus/test_omegak.py)."""
+    from sarcli.focus import FOCUSERS
     from sarcli.focus.base import make_plan, run_blocks
-    from sarcli.focus.rda import RD
 
+    focuser = FOCUSERS.get(name)
     raw = scene(_targets()[1:3], n_lines=2400, n_samples=300, fdc=fdc_of_t, pulse=10e-6, chirp_rate=-2e12,
                 exposure_bw_hz=EXPOSURE)
-    plan = make_plan(RD, raw, raw.echo.shape, RateHeld(), {"block_lines": 512, "azimuth_bandwidth_hz": 1000.0},
+    plan = make_plan(focuser, raw, raw.echo.shape, RateHeld(), {"block_lines": 512, "azimuth_bandwidth_hz": 1000.0},
                      None)
     assert plan.n_blocks == 3
     serial = np.empty(plan.output_shape, np.complex64)
@@ -242,10 +245,10 @@ def test_blocks_are_pure_functions_of_the_plan():
     def sink(first, block):
         serial[first:first + block.shape[0]] = block
 
-    run_blocks(RD, plan, lambda a, b: raw.echo[a:b], sink)
+    run_blocks(focuser, plan, lambda a, b: raw.echo[a:b], sink)
     for b in reversed(range(plan.n_blocks)):
         s, e = plan.block_rows(b)
-        np.testing.assert_array_equal(RD.focus_block(plan, b, lambda a, z: raw.echo[a:z].copy()), serial[s:e])
+        np.testing.assert_array_equal(focuser.focus_block(plan, b, lambda a, z: raw.echo[a:z].copy()), serial[s:e])
 
 
 def test_correct_lines_matches_numpy_and_shifts_a_band_pass_signal():

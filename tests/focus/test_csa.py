@@ -32,7 +32,7 @@ from sarcli.focus.rangecomp import compress_lines, range_filter
 from sarcli.focus.rda import focus_rd
 from sarcli.model.doppler import GeometricDoppler
 
-from .synth import C, beam_offset, scene, sin_squint
+from .synth import C, focus_spaceborne, scene
 from .theory import irf_theory
 
 PRF, FS, LAM, V, BA = 1500.0, 24e6, 0.0566, 7000.0, 1200.0
@@ -43,13 +43,7 @@ SQUINT_FDC = -3.4 * PRF
 
 
 def _spaceborne(fdc, window, focus=focus_csa, **kw):
-    eta0 = 0.34 + 0.37 / PRF - beam_offset(R0, fdc)
-    raw = scene([(R0, eta0, 1.0)], fdc=fdc)
-    dop = GeometricDoppler(V, sin_squint(fdc), LAM)
-    slc = focus(raw, dop, range_window=window, azimuth_window=window, range_bandwidth_fraction=0.9,
-                azimuth_bandwidth_hz=BA, **kw)
-    row = float(np.interp(eta0, slc.azimuth_time, np.arange(slc.azimuth_time.size)))
-    return raw, slc, row, (R0 - slc.slant_range[0]) / DR
+    return focus_spaceborne(focus, fdc, window, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -257,28 +251,6 @@ def test_block_size_does_not_change_the_image(model_name):
         for bl in res:
             m = res[bl][0]
             assert np.max(np.abs(np.angle(np.exp(1j * (m[:, 1] + 4 * np.pi * m[:, 2] / LAM))))) < 0.05, bl
-
-
-def test_blocks_are_pure_functions_of_the_plan():
-    from sarcli.focus.base import make_plan, run_blocks
-    from sarcli.focus.csa import CSA
-
-    from . import test_block_invariance as tb
-
-    raw = scene(tb._targets()[1:3], n_lines=2400, n_samples=300, fdc=tb.fdc_of_t, pulse=10e-6, chirp_rate=-2e12,
-                exposure_bw_hz=tb.EXPOSURE)
-    plan = make_plan(CSA, raw, raw.echo.shape, tb.RateHeld(), {"block_lines": 512, "azimuth_bandwidth_hz": 1000.0},
-                     None)
-    assert plan.n_blocks == 3
-    serial = np.empty(plan.output_shape, np.complex64)
-
-    def sink(first, block):
-        serial[first:first + block.shape[0]] = block
-
-    run_blocks(CSA, plan, lambda a, b: raw.echo[a:b], sink)
-    for b in reversed(range(plan.n_blocks)):
-        s, e = plan.block_rows(b)
-        np.testing.assert_array_equal(CSA.focus_block(plan, b, lambda a, z: raw.echo[a:z].copy()), serial[s:e])
 
 
 # ---- hard cases -----------------------------------------------------------------------------------------

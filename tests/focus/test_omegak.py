@@ -44,7 +44,7 @@ from sarcli.focus.rangecomp import compress_lines, range_filter
 from sarcli.focus.rda import focus_rd, plan_grid
 from sarcli.model.doppler import GeometricDoppler
 
-from .synth import C, beam_offset, scene, sin_squint
+from .synth import C, focus_spaceborne, scene, sin_squint
 from .theory import irf_theory
 
 # ---------------------------------------------------------------- the Stolt kernel
@@ -171,13 +171,7 @@ R0 = 850e3 + 384.3 * DR
 
 
 def _space(fdc, window, **kw):
-    eta0 = 0.34 + 0.37 / PRF - beam_offset(R0, fdc)
-    raw = scene([(R0, eta0, 1.0)], fdc=fdc)
-    dop = GeometricDoppler(V, sin_squint(fdc), LAM)
-    slc = focus_omegak(raw, dop, range_window=window, azimuth_window=window, range_bandwidth_fraction=0.9,
-                       azimuth_bandwidth_hz=BA, **kw)
-    row = float(np.interp(eta0, slc.azimuth_time, np.arange(slc.azimuth_time.size)))
-    return raw, slc, row, (R0 - slc.slant_range[0]) / DR
+    return focus_spaceborne(focus_omegak, fdc, window, **kw)
 
 
 @pytest.fixture(scope="module")
