@@ -9,17 +9,16 @@ import json
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 import pytest
 
-from tests.gpu.test_bp_cuda import REPO, _env
+from tests.gpu.cli_pair import REPO, gbsar_cpu_and_cuda, sim_env
 
 
 @pytest.fixture(scope="module")
 def checks() -> dict:
     out = subprocess.run([sys.executable, str(REPO / "tests" / "gpu" / "ffbp_sim_checks.py")], cwd=REPO,
-                         env=_env(), capture_output=True, text=True, timeout=900)
+                         env=sim_env(), capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
     return json.loads(out.stdout)
 
@@ -62,35 +61,10 @@ def test_gbsar_focus_ffbp_on_the_simulated_device_equals_the_cpu(tmp_path):
     paths share their arithmetic: module docstring of sarcli.gpu.ffbp_cuda; its bound, divided by the weight
     sum, with W = sum_i w_i max|P_i| <= the largest profile sample times the weight sum; k from the band's
     top frequency 5.6 GHz < c / 0.05 m, ranges and coordinates below 100 m, at most log_4(stops) merges)."""
-    scan = tmp_path / "scan.h5"
-    grid = "-0.5,0.5,0.25,4.5,5.5,0.25"
-    steps = [["gbsar", "simulate", "samples/gbsar_indoor.toml", "-o", str(scan)],
-             ["gbsar", "focus", str(scan), "--algorithm", "ffbp", "--grid", grid, "-o", str(tmp_path / "cpu.h5")],
-             ["gbsar", "focus", str(scan), "--algorithm", "ffbp", "--grid", grid, "-o", str(tmp_path / "gpu.h5"),
-              "--device", "cuda"]]
-    code = ("import sys\nfrom sarcli.cli.app import app\n"
-            "try:\n    app(sys.argv[1:])\nexcept SystemExit as e:\n    sys.exit(e.code)\n")
-    for args in steps:
-        out = subprocess.run([sys.executable, "-c", code, *args], cwd=REPO, env=_env(), capture_output=True,
-                             text=True, timeout=900)
-        assert out.returncode == 0, (args, out.stderr[-2000:])
-
-    def image(name):
-        with h5py.File(tmp_path / name) as f:
-            key = "image" if "image" in f else next(k for k in f if isinstance(f[k], h5py.Dataset)
-                                                    and np.iscomplexobj(f[k]))
-            return np.asarray(f[key])
-
     from sarcli.focus.ffbp import FfbpKnobs
-    from sarcli.gbsar.rangecomp import range_compress
     from sarcli.gpu.ffbp_cuda import ffbp_bound
-    from sarcli.io.scan import read_scan
 
-    s = read_scan(scan)
-    largest = max(float(np.abs(range_compress(s, p, "hamming", 4, centred=True).data).max())
-                  for p in s.polarizations)
-    cpu, gpu = image("cpu.h5"), image("gpu.h5")
-    assert cpu.shape == gpu.shape and np.abs(cpu).max() > 0
+    s, cpu, gpu, largest = gbsar_cpu_and_cuda(tmp_path, "ffbp", "-0.5,0.5,0.25,4.5,5.5,0.25", 900)
     stages = int(np.ceil(np.log(s.n_stops) / np.log(4)))  # at most log_base(stops) merges
     n = s.n_stops
     bound = ffbp_bound(FfbpKnobs(aperture_split=64), stages, 2.0, np.full((n, 1), largest), np.full(n, 1.0 / n),
