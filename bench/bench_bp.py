@@ -52,7 +52,7 @@ def main() -> None:
     from sarcli.focus.bp_product import BACKPROJECTION, BpOptions, focus_bp
     from sarcli.focus.geolocation import platform_state, zero_doppler_points
     from sarcli.focus.phasor import ANCHOR_EVERY
-    from sarcli.focus.quality import point_target_metrics, truth_targets
+    from sarcli.focus.quality import TruthDoppler, point_target_metrics, truth_targets
     from sarcli.focus.rangecomp import C, compress_lines
     from sarcli.focus.windows import window_table
     from sarcli.model.terrain import ConstantHeight
@@ -63,14 +63,7 @@ def main() -> None:
     rng = raw.slant_range()
     drng = float(rng[1] - rng[0])
 
-    class TruthDoppler:
-        def fdc(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_centroid_hz"])
-
-        def fr(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_rate_hz_per_s"])
-
-    dop = TruthDoppler()
+    dop = TruthDoppler.of(raw)
     probe = focus_bp(raw, dop, samples=(0, 1), precision="double")
     prf = raw.radar.prf_hz
     targets = truth_targets(raw.truth)

@@ -24,7 +24,7 @@ import numpy as np
 
 from bench.common import best_time, markdown_table, write_results
 from sarcli.focus.ffbp import FfbpKnobs
-from sarcli.focus.quality import point_target_metrics
+from sarcli.focus.quality import TruthDoppler, point_target_metrics
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("SARCLI_SHARED", REPO.parent / "shared")) / "data" / "gotcha_pass1_hh"
@@ -108,16 +108,8 @@ def bench_stripmap() -> dict:
 
     text = (REPO / "samples" / "rs1_point.toml").read_text()
     raw = simulate(parse_scene(text.replace('"chirp_replica", "noise", "quantization"]', '"chirp_replica"]')))
-    rng = raw.slant_range()
 
-    class TruthDoppler:
-        def fdc(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_centroid_hz"])
-
-        def fr(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_rate_hz_per_s"])
-
-    dop = TruthDoppler()
+    dop = TruthDoppler.of(raw)
     tz, r0 = truth_targets(raw.truth)[0]
     g = plan_grid(raw, raw.echo.shape, dop, None)
     row = int(round(np.interp(tz, g.zero_doppler_times(raw.azimuth_time), np.arange(raw.azimuth_time.size))))

@@ -154,21 +154,14 @@ def _measure(slc, raw) -> dict:
 
 def bench_accuracy() -> dict:
     from sarcli.focus.bp_product import focus_bp
+    from sarcli.focus.quality import TruthDoppler
     from sarcli.focus.rda import focus_rd
     from sarcli.sim.scene import load_scene
     from sarcli.sim.stripmap import simulate
 
     raw = simulate(load_scene(REPO / "samples" / "rs1_point.toml"))
-    rng = raw.slant_range()
 
-    class TruthDoppler:
-        def fdc(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_centroid_hz"])
-
-        def fr(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_rate_hz_per_s"])
-
-    dop = TruthDoppler()
+    dop = TruthDoppler.of(raw)
     base = {"range_window": "rect", "azimuth_window": "rect"}
     configs = [("RD sinc8 x2 SRC f32 (default)", {}),
                ("RD nearest x2", {"rcmc": "nearest"}), ("RD linear x2", {"rcmc": "linear"}),

@@ -177,6 +177,32 @@ def point_target_metrics(image: np.ndarray, row: float, col: float, search: int 
     }
 
 
+@dataclass(frozen=True)
+class TruthDoppler:
+    """A simulated product's Doppler truth as a Doppler model (:class:`sarcli.model.doppler.DopplerModel`):
+    centroid (Hz) and rate (Hz/s) per slant range (m), interpolated linearly, the same at every time; for
+    benchmarks and tests that must take the estimator out of a focuser's error."""
+
+    ranges_m: np.ndarray
+    centroid_hz: np.ndarray
+    rate_hz_per_s: np.ndarray
+
+    @classmethod
+    def of(cls, raw) -> TruthDoppler:
+        """The truth of the simulated raw product ``raw`` (its ``doppler_centroid_hz``, ``doppler_rate_hz_per_s``
+        per range sample)."""
+        if raw.truth is None or "doppler_centroid_hz" not in raw.truth:
+            raise ProductError("the product carries no Doppler truth (not simulated by sarcli simulate)")
+        return cls(raw.slant_range(), np.asarray(raw.truth["doppler_centroid_hz"], np.float64),
+                   np.asarray(raw.truth["doppler_rate_hz_per_s"], np.float64))
+
+    def fdc(self, range_m, azimuth_time_s=0.0) -> np.ndarray:
+        return np.interp(range_m, self.ranges_m, self.centroid_hz)
+
+    def fr(self, range_m, azimuth_time_s=0.0) -> np.ndarray:
+        return np.interp(range_m, self.ranges_m, self.rate_hz_per_s)
+
+
 def truth_targets(truth: dict | None) -> list[tuple[float, float]]:
     """(zero-Doppler time s, closest range m) of the point targets in a simulated product's truth."""
     if truth is None or "targets" not in truth:

@@ -112,8 +112,8 @@ COST_BP = 35.0  # bench_focus_family: the exact kernel over its aperture, extrap
 #: per pixel for the model's (S + 1) base beta U taps = 5 x 4 x 2 x 2 x 36 = 2880 taps; on bench_ffbp's
 #: stripmap scene (710 aperture lines) the model then predicts 1.9x and 2.3x was measured. The product of
 #: the taps stands for the last stage's 2-D interpolation; the merges cost about order + range_order plus a
-#: fixed part (the along-ray merge), so the model ranks coarser kernels too costly (4 x 4 taps: 0.85x the
-#: defaults' time, predicted 0.44x): re-measured by the map
+#: fixed part (the along-ray merge), so the model takes coarser kernels for cheaper than they are (4 x 4
+#: taps: 0.80-0.85x the defaults' time in bench_ffbp, predicted 0.44x): to be re-measured by the map
 COST_FFBP_TAP = 367.0 / 2880.0
 #: the 2 fft2 time per (sample x log2 samples) on the bench machine (s): predicted seconds for the report
 SECONDS_2FFT2 = 4.0e-9  # bench_focus_family on the shared 2-core machine (1.6e-9 unloaded, bench_focus)

@@ -22,7 +22,7 @@ from sarcli.focus.backprojection import (
     line_anchor_interval,
 )
 from sarcli.focus.phasor import ANCHOR_EVERY, EPS_MAX, U32, range_phase_bound, recurrence_bound
-from sarcli.focus.quality import point_target_metrics
+from sarcli.focus.quality import TruthDoppler, point_target_metrics
 from sarcli.focus.windows import window, window_table
 
 WINDOW = "kaiser:2.5"
@@ -198,21 +198,13 @@ def test_focuser_point_target_single_vs_double():
     scene = dataclasses.replace(scene, effects=tuple(e for e in scene.effects if e not in ("noise", "quantization")))
     raw = simulate(scene)
     rng = raw.slant_range()
-
-    class TruthDoppler:
-        def fdc(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_centroid_hz"])
-
-        def fr(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_rate_hz_per_s"])
-
     tz, r0 = truth_targets(raw.truth)[0]
-    probe = focus_bp(raw, TruthDoppler(), samples=(0, 1), precision="double")
+    probe = focus_bp(raw, TruthDoppler.of(raw), samples=(0, 1), precision="double")
     row = int(round((tz - probe.azimuth_time[0]) * raw.radar.prf_hz))
     col = int(round((r0 - rng[0]) / (rng[1] - rng[0])))  # the BP grid's ranges are the raw ones
     m, lam = {}, raw.radar.wavelength_m
     for precision in ("single", "double"):
-        slc = focus_bp(raw, TruthDoppler(), range_window="rect", azimuth_window="rect", precision=precision,
+        slc = focus_bp(raw, TruthDoppler.of(raw), range_window="rect", azimuth_window="rect", precision=precision,
                        lines=(row - 64, row + 64), samples=(col - 64, col + 64))
         assert slc.image.dtype == np.complex64
         m[precision] = point_target_metrics(slc.image, 64 + (tz - slc.azimuth_time[64]) * raw.radar.prf_hz,

@@ -286,6 +286,7 @@ def test_knobs_are_checked():
 
 @pytest.fixture(scope="module")
 def rs1():
+    from sarcli.focus.quality import TruthDoppler
     from sarcli.sim.scene import parse_scene
     from sarcli.sim.stripmap import simulate
     from tests.conftest import SAMPLES
@@ -293,16 +294,7 @@ def rs1():
     text = (SAMPLES / "rs1_point.toml").read_text()
     text = text.replace('"chirp_replica", "noise", "quantization"]', '"chirp_replica"]')
     raw = simulate(parse_scene(text))
-    rng = raw.slant_range()
-
-    class TruthDoppler:
-        def fdc(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_centroid_hz"])
-
-        def fr(self, r, t):
-            return np.interp(r, rng, raw.truth["doppler_rate_hz_per_s"])
-
-    return raw, TruthDoppler()
+    return raw, TruthDoppler.of(raw)
 
 
 @pytest.mark.slow
