@@ -268,6 +268,24 @@ def test_peak_error_within_the_model(point_scene, order, beta, base, range_order
     assert err <= bound, (err, bound)
 
 
+def test_the_image_does_not_depend_on_the_thread_count(point_scene):
+    """Rows and pixel chunks are independent tasks (module docstring): one thread and two give the same
+    image bit for bit."""
+    import numba
+
+    before = numba.get_num_threads()
+    images = []
+    try:
+        for n in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(n)
+            images.append(ffbp(point_scene["lines"], point_scene["grid"][0], point_scene["dr"], C / (2 * B), LAM_C,
+                               point_scene["lam_min"], point_scene["pos"], np.zeros(256), np.ones(256),
+                               point_scene["pix"], np.zeros(point_scene["pix"].shape[:2]), FfbpKnobs())[0])
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(images[0], images[1])
+
+
 def test_error_falls_as_the_knobs_tighten(point_scene):
     errs = [_peak_error(point_scene, FfbpKnobs(oversample=b, order=n, range_order=n, range_oversample=b))[0]
             for b, n in ((1.5, 4), (2.0, 6), (3.0, 8))]
