@@ -326,13 +326,23 @@ def _phasors(k, a, b, n, cr, ci):
         cr[i], ci[i] = cis(k * (a[i] - b[i]))
 
 
+@njit(cache=True, inline="always")
+def _line_at(lines, m, p):
+    """(line ``m`` interpolated linearly at fractional sample ``p``, whether p lies in [0, n - 1); False for
+    NaN): the exact kernels' read of a range-compressed line."""
+    if not (p >= 0.0 and p < lines.shape[1] - 1):
+        return 0j, False
+    j = int(p)
+    mu = p - j
+    return lines[m, j] * (1.0 - mu) + lines[m, j + 1] * mu, True
+
+
 @njit(cache=True)
 def _stage0_row(lines, r_first, dr_in, k, pos, ref, w, n0, n1, fr, p0, nrm, r0, u, n, dr, pts, r, rho, cr, ci, acc):
     """``acc[:n]``: the stage-0 row (ranges r0 + i dr at angle u) of frame ``fr``, the pulses n0..n1-1
     backprojected there pulse by pulse (linear interpolation of the line at rho_n, the phasor of each
     pulse's ranges in one vectorizable pass); ``pts`` (>= n, 3), ``r``, ``rho``, ``cr``, ``ci``, ``acc``
     (>= n): scratch (the CPU and the CUDA kernels share this code)."""
-    n_in = lines.shape[1]
     _row_points(fr, p0, nrm, r0, u, n, dr, pts, r)
     for i in range(n):
         acc[i] = 0j
@@ -346,13 +356,9 @@ def _stage0_row(lines, r_first, dr_in, k, pos, ref, w, n0, n1, fr, p0, nrm, r0, 
             rho[i] = math.sqrt(dx * dx + dy * dy + dz * dz) - ref[m]
         _phasors(k, rho, r, n, cr, ci)
         for i in range(n):
-            p = (rho[i] - r_first) / dr_in
-            j = int(math.floor(p))
-            if j < 0 or j + 1 >= n_in:
-                continue
-            mu = p - j
-            v = lines[m, j] * (1.0 - mu) + lines[m, j + 1] * mu
-            acc[i] += w[m] * v * complex(cr[i], ci[i])
+            v, ok = _line_at(lines, m, (rho[i] - r_first) / dr_in)
+            if ok:
+                acc[i] += w[m] * v * complex(cr[i], ci[i])
 
 
 @njit(cache=True, parallel=True)
@@ -389,14 +395,12 @@ def _inside(nr, nu, fr_, fu, order, range_order):
 def _interp(img, off, nr, nu, fr_, fu, order, range_order, tab_u, tab_r, wr, wu):
     """Interpolation of a polar image (rows u, columns r) at fractional (fr_, fu); 0 if the stencil
     leaves the grid (or a coordinate is not finite: compared before any integer conversion)."""
-    if not (fr_ >= 0.0 and fu >= 0.0 and fr_ < nr and fu < nu):
+    if not _inside(nr, nu, fr_, fu, order, range_order):
         return 0j
     ir = int(math.floor(fr_))
     iu = int(math.floor(fu))
     r_lo = ir - range_order // 2 + 1
     u_lo = iu - order // 2 + 1
-    if r_lo < 0 or u_lo < 0 or r_lo + range_order > nr or u_lo + order > nu:
-        return 0j
     _weights(range_order, fr_ - ir, tab_r, wr)
     _weights(order, fu - iu, tab_u, wu)
     acc_re = 0.0  # real and imaginary sums: real weights times complex64 samples without complex products
@@ -463,9 +467,9 @@ def _column_along_ray(child, off, nr, nu, j, fu, order, tab_u, wu):
 def _merge_child_along_ray(child, c_r0, c_u0, c_du, nr, nu, off, rcs, ucs, cr, ci, n, dr, order, range_order, tab_u,
                            tab_r, wr, wu, col, acc):
     """Add one child to a parent row by the along-ray merge (module docstring): the child's columns j
-    interpolated in angle where the row's ray crosses them (its angle there linear between the bracketing
-    samples), then each parent sample interpolated in range along that curve and re-referenced by the phasors
-    ``cr + j ci``."""
+    interpolated in angle where the row's ray crosses them (its angle there from the row's nearest sample
+    below r_j along the row's mean slope), then each parent sample interpolated in range along that curve and
+    re-referenced by the phasors ``cr + j ci``."""
     j0 = max(0, int(math.floor((rcs[0] - c_r0) / dr)) - range_order // 2 + 1)
     j1 = min(nr - 1, int(math.floor((rcs[n - 1] - c_r0) / dr)) + range_order // 2)
     slope = (ucs[n - 1] - ucs[0]) / ((rcs[n - 1] - rcs[0]) * c_du)  # angle samples per metre, the row's mean
@@ -556,7 +560,6 @@ def _final_pixels(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, s
     pixel's interpolation (or its pulse-by-pulse backprojection). ``rcs``, ``frs``, ``fus``, ``cr``, ``ci``,
     ``acc``, ``wsa`` (>= m1 - m0): scratch. The CPU kernel calls it once per chunk of pixels, the CUDA kernel
     once per pixel: they share this code."""
-    n_in = lines.shape[1]
     n_m = m1 - m0
     for t in range(n_m):
         acc[t] = 0j
@@ -594,13 +597,11 @@ def _final_pixels(img, frames, g_r0, g_u0, g_du, g_nr, g_nu, g_off, sub_start, s
                 ey = y - pos[n, 1]
                 ez = z - pos[n, 2]
                 rho = math.sqrt(ex * ex + ey * ey + ez * ez) - ref[n]
-                p = (rho - r_first) / dr_in
-                if not (p >= 0.0 and p < n_in - 1):
+                v, ok = _line_at(lines, n, (rho - r_first) / dr_in)
+                if not ok:
                     continue
-                i = int(p)
-                mu = p - i
                 c, sn = cis(k * (rho - r_outs[m]))
-                acc[t] += wn * (lines[n, i] * (1.0 - mu) + lines[n, i + 1] * mu) * complex(c, sn)
+                acc[t] += wn * v * complex(c, sn)
                 wsa[t] += wn
     for t in range(n_m):
         out[m0 + t] = acc[t]

@@ -42,12 +42,12 @@ class FfbpOptions(BpOptions):
     accuracy bar (peaks within 0.1 pixel, PSLR within 0.5 dB of
     BP; docs/focusing.md)."""
 
-    base: int = 4
-    oversample: float = 2.0
-    order: int = 6
-    range_order: int = 6
-    range_oversample: float = 2.0
-    aperture_split: int = 16
+    base: int = FfbpKnobs.base
+    oversample: float = FfbpKnobs.oversample
+    order: int = FfbpKnobs.order
+    range_order: int = FfbpKnobs.range_order
+    range_oversample: float = FfbpKnobs.range_oversample
+    aperture_split: int = FfbpKnobs.aperture_split
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -57,8 +57,7 @@ class FfbpOptions(BpOptions):
                               "--double / precision")
 
     def knobs(self) -> FfbpKnobs:
-        return FfbpKnobs(base=self.base, oversample=self.oversample, order=self.order, range_order=self.range_order,
-                         range_oversample=self.range_oversample, aperture_split=self.aperture_split)
+        return FfbpKnobs(**{f.name: getattr(self, f.name) for f in fields(FfbpKnobs)})
 
 
 @dataclass

@@ -55,7 +55,7 @@ MAX_ORDER = cpu.MAX_ORDER
 
 # the @njit helpers of sarcli.focus.ffbp (cis: of sarcli.focus.phasor), callees before callers
 _HELPERS = ("_weights", "cis", "_polar_point", "_row_points", "_phasors", "_band_u", "_cum", "_table", "_window_mean",
-            "_inside", "_interp", "_stage0_row", "_child_polar", "_ray_is_separable", "_column_along_ray",
+            "_inside", "_interp", "_line_at", "_stage0_row", "_child_polar", "_ray_is_separable", "_column_along_ray",
             "_merge_child_along_ray", "_merge_row", "_final_pixels")
 _TWINS: dict[str, Any] = {}
 
