@@ -183,6 +183,21 @@ def test_apply_line_phase_matches_numpy():
     np.testing.assert_allclose(out, ref, rtol=0, atol=2e-6 * np.abs(img).max())
 
 
+def demo_scene_target_rows(slc, truth) -> np.ndarray:
+    """Per truth target of a focused demo scene (samples/rs1_point.toml): (peak amplitude, peak phase rad,
+    closest range m, azimuth position minus the truth's, lines), the phase at the target's absolute carrier
+    (:func:`carrier`)."""
+    from sarcli.focus.quality import truth_targets
+
+    rows = []
+    for tz, r0 in truth_targets(truth):
+        row = (tz - slc.azimuth_time[0]) * slc.prf_hz
+        col = (r0 - slc.slant_range[0]) / slc.range_spacing_m
+        m = point_target_metrics(slc.image, row, col, azimuth_carrier=carrier(slc, row, col))
+        rows.append((m["peak_amplitude"], m["peak_phase_rad"], r0, m["row"] - row))
+    return np.array(rows)
+
+
 @pytest.mark.slow
 def test_block_size_on_the_simulated_orbit_scene():
     """The demo scene (samples/rs1_point.toml: rotating Earth, antenna pattern, 4-bit data) with the
@@ -193,7 +208,6 @@ def test_block_size_on_the_simulated_orbit_scene():
     from pathlib import Path
 
     from sarcli.doppler.api import estimate_doppler
-    from sarcli.focus.quality import truth_targets
     from sarcli.sim.scene import load_scene
     from sarcli.sim.stripmap import simulate
 
@@ -205,13 +219,7 @@ def test_block_size_on_the_simulated_orbit_scene():
     res = {}
     for bl in (1024, 2048, 4096):
         slc = focus_rd(raw, dop, block_lines=bl)
-        rows = []
-        for tz, r0 in truth_targets(raw.truth):
-            row = (tz - slc.azimuth_time[0]) * slc.prf_hz
-            col = (r0 - slc.slant_range[0]) / slc.range_spacing_m
-            m = point_target_metrics(slc.image, row, col, azimuth_carrier=carrier(slc, row, col))
-            rows.append((m["peak_amplitude"], m["peak_phase_rad"], r0, m["row"] - row))
-        res[bl] = (np.array(rows), slc.parameters["n_blocks"])
+        res[bl] = (demo_scene_target_rows(slc, raw.truth), slc.parameters["n_blocks"])
     assert sorted({res[b][1] for b in res}) == [1, 2, 3]
     ref = res[4096][0]
     for bl in (1024, 2048):

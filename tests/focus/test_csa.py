@@ -499,11 +499,10 @@ def test_orbit_scene_with_the_estimated_doppler():
     from pathlib import Path
 
     from sarcli.doppler.api import estimate_doppler
-    from sarcli.focus.quality import truth_targets
     from sarcli.sim.scene import load_scene
     from sarcli.sim.stripmap import simulate
 
-    from .test_block_invariance import carrier
+    from .test_block_invariance import demo_scene_target_rows
 
     raw = simulate(load_scene(Path(__file__).resolve().parents[2] / "samples" / "rs1_point.toml"))
     dop = estimate_doppler(raw)
@@ -514,13 +513,7 @@ def test_orbit_scene_with_the_estimated_doppler():
     for bl in (2048, 4096):
         slc = focus_csa(raw, dop, block_lines=bl)
         layouts.add(slc.parameters["n_blocks"])
-        rows = []
-        for tz, r0 in truth_targets(raw.truth):
-            row = (tz - slc.azimuth_time[0]) * slc.prf_hz
-            col = (r0 - slc.slant_range[0]) / slc.range_spacing_m
-            m = point_target_metrics(slc.image, row, col, azimuth_carrier=carrier(slc, row, col))
-            rows.append((m["peak_amplitude"], m["peak_phase_rad"], r0, m["row"] - row))
-        res[bl] = np.array(rows)
+        res[bl] = demo_scene_target_rows(slc, raw.truth)
     a, b = res[2048], res[4096]
     assert len(layouts) == 2  # two different block layouts
     assert np.max(np.abs(np.angle(np.exp(1j * (a[:, 1] - b[:, 1]))))) < 0.01

@@ -17,7 +17,7 @@ from sarcli.focus.rangecomp import compress_lines, range_filter
 from sarcli.focus.rda import focus_rd
 from sarcli.model.doppler import GeometricDoppler
 
-from .synth import C, beam_offset, scene, sin_squint
+from .synth import C, beam_offset, focus_spaceborne, scene, sin_squint
 from .theory import irf_theory
 
 PRF, FS, LAM, V, BA = 1500.0, 24e6, 0.0566, 7000.0, 1200.0
@@ -28,14 +28,7 @@ SQUINT_FDC = -3.4 * PRF  # a centroid of several PRFs (Radarsat-1-like)
 
 
 def _focus(fdc, window, **kw):
-    eta0 = 0.34 + 0.37 / PRF - beam_offset(R0, fdc)
-    raw = scene([(R0, eta0, 1.0)], fdc=fdc)
-    dop = GeometricDoppler(V, sin_squint(fdc), LAM)
-    slc = focus_rd(raw, dop, range_window=window, azimuth_window=window, range_bandwidth_fraction=0.9,
-                   azimuth_bandwidth_hz=BA, **kw)
-    row = float(np.interp(eta0, slc.azimuth_time, np.arange(slc.azimuth_time.size)))
-    col = (R0 - slc.slant_range[0]) / DR
-    return raw, slc, row, col, eta0
+    return focus_spaceborne(focus_rd, fdc, window, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +42,7 @@ def focused():
 @pytest.mark.parametrize("fdc", [0.0, SQUINT_FDC], ids=["broadside", "squint3.4prf"])
 @pytest.mark.parametrize("window", ["rect", "hamming"])
 def test_irf_matches_window_theory(focused, fdc, window):
-    _, slc, row, col, _ = focused[(fdc, window)]
+    _, slc, row, col = focused[(fdc, window)]
     m = point_target_metrics(slc.image, row, col)
     th = irf_theory(window)
     # theory in pixels: range cell = fs / B samples, azimuth cell = PRF / Ba lines
@@ -67,7 +60,7 @@ def test_irf_matches_window_theory(focused, fdc, window):
 
 @pytest.mark.parametrize("fdc", [0.0, SQUINT_FDC], ids=["broadside", "squint3.4prf"])
 def test_peak_phase_is_minus_4pi_r0_over_lambda(focused, fdc):
-    _, slc, row, col, _ = focused[(fdc, "rect")]
+    _, slc, row, col = focused[(fdc, "rect")]
     m = point_target_metrics(slc.image, row, col, azimuth_carrier=fdc / PRF)
     err = np.angle(np.exp(1j * (m["peak_phase_rad"] + 4 * np.pi * R0 / LAM)))
     assert abs(err) < 0.02
@@ -83,7 +76,7 @@ def test_squinted_scene_focuses_as_well_as_broadside(focused):
 
 
 def test_rd_agrees_with_backprojection(focused):
-    raw, slc, row, col, _ = focused[(SQUINT_FDC, "rect")]
+    raw, slc, row, col = focused[(SQUINT_FDC, "rect")]
     h, _ = range_filter(raw.radar, 2048, "rect", None, 0.9)
     rc = compress_lines(raw.echo.astype(np.complex128), h, raw.echo.shape[1])
     rows = np.arange(int(row) - 20, int(row) + 20)
